@@ -1,0 +1,22 @@
+"""mjeap: electroactive-polymer and piezoelectric bending actuators as MuJoCo scenes.
+
+SI units at the API; MuJoCo runs in scaled internal units (see :mod:`mjeap.units`).
+"""
+import os as _os
+
+# headless by default: mjeap never opens a window, and dm_control must not probe GLFW
+_os.environ.setdefault("MUJOCO_GL", "disable")
+
+from .catalog import CATALOG, Actuator, Layer, Planform, get_actuator, actuator_ids  # noqa: E402
+from .discretize import BeamLayout, Payload, discretize, parse_quantity  # noqa: E402
+from .errors import DivergenceError, MjeapError, ParameterError, UnknownNameError  # noqa: E402
+from .mjcf import REPRESENTATIONS, build_spec  # noqa: E402
+from .scene import Scene, load_mjcf  # noqa: E402
+from .units import DEFAULT_UNITS, UnitSystem  # noqa: E402
+from . import analytical  # noqa: E402
+
+__version__ = "0.1.0"
+__all__ = ["CATALOG", "Actuator", "Layer", "Planform", "get_actuator", "actuator_ids", "BeamLayout",
+           "Payload", "discretize", "parse_quantity", "DivergenceError", "MjeapError", "ParameterError",
+           "UnknownNameError", "REPRESENTATIONS", "build_spec", "Scene", "load_mjcf", "DEFAULT_UNITS",
+           "UnitSystem", "analytical"]

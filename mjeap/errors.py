@@ -1,0 +1,67 @@
+"""Errors raised by mjeap: each names the parameter and what would have been accepted."""
+from __future__ import annotations
+
+import difflib
+from typing import Iterable
+
+
+class MjeapError(Exception):
+    """Base class of mjeap's own errors."""
+
+
+class ParameterError(MjeapError, ValueError):
+    """A parameter is outside its accepted range.
+
+    The message always names the parameter, the value given and the range accepted.
+    """
+
+    def __init__(self, name: str, value, accepted: str, why: str = ""):
+        self.name, self.value, self.accepted = name, value, accepted
+        msg = f"{name}={value!r} is not accepted: expected {accepted}"
+        if why:
+            msg += f" ({why})"
+        super().__init__(msg)
+
+
+class UnknownNameError(MjeapError, KeyError):
+    """A name (actuator, drive, waveform) is not registered; suggests the closest ones."""
+
+    def __init__(self, kind: str, name: str, known: Iterable[str]):
+        known = sorted(known)
+        close = difflib.get_close_matches(name, known, n=3, cutoff=0.4)
+        msg = f"unknown {kind} {name!r}"
+        if close:
+            msg += f"; did you mean {', '.join(repr(c) for c in close)}?"
+        msg += f" Known: {', '.join(known)}"
+        self.kind, self.name, self.known, self.suggestions = kind, name, known, close
+        super().__init__(msg)
+
+    def __str__(self) -> str:  # KeyError quotes its message otherwise
+        return self.args[0]
+
+
+class DivergenceError(MjeapError, RuntimeError):
+    """The simulation became unstable; the message says at which step and why."""
+
+
+def check_positive(name: str, value: float, unit: str = "") -> float:
+    """Return ``float(value)`` if it is finite and > 0, else raise ParameterError."""
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(name, value, f"a positive number{(' in ' + unit) if unit else ''}") from None
+    if not (v > 0 and v < float("inf")):
+        raise ParameterError(name, value, f"a finite number > 0{(' ' + unit) if unit else ''}")
+    return v
+
+
+def check_range(name: str, value: float, lo: float, hi: float, unit: str = "",
+                lo_open: bool = False, hi_open: bool = False) -> float:
+    """Return ``float(value)`` if it lies in the interval, else raise ParameterError."""
+    v = float(value)
+    ok_lo = v > lo if lo_open else v >= lo
+    ok_hi = v < hi if hi_open else v <= hi
+    if not (ok_lo and ok_hi) or v != v:
+        interval = f"{'(' if lo_open else '['}{lo:.6g}, {hi:.6g}{')' if hi_open else ']'}"
+        raise ParameterError(name, value, f"a value in {interval}{(' ' + unit) if unit else ''}")
+    return v

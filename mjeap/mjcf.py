@@ -1,0 +1,229 @@
+"""MJCF model building: a clamped beam, its payload and options, as a ``mujoco.MjSpec``.
+
+Two representations sit behind one interface, :class:`BeamBuilder`:
+
+* ``hinge``: a planar chain of rigid links joined by damped hinge springs (seed 001's
+  16-link model, any N), built with MjSpec.
+* ``cable``: MuJoCo's ``composite type="cable"`` with the ``mujoco.elasticity.cable``
+  plugin (3D: bending in both directions and twist). The composite is expanded by MuJoCo's
+  parser; each segment's geom then carries its own stiffness (the plugin computes E*I from
+  the geom's box section, divided by the distance to the previous body) and each body an
+  explicit inertial.
+
+Both place their hinges by the midpoint rule of :mod:`mjeap.discretize`. Body frames: the
+origin of link j is hinge j, local x runs along the beam, local y is the deflection
+(thickness) direction and local z the hinge (width) axis. Everything is written in the
+internal units of a :class:`~mjeap.units.UnitSystem`. A MuJoCo 4 backend (1D flexcomp rods)
+would be a third builder.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Dict, List, Optional
+
+import mujoco
+import numpy as np
+
+from .discretize import BeamLayout, Payload, clamp_rotation
+from .errors import UnknownNameError
+from .units import UnitSystem
+
+GRAVITY = 9.80665  # m/s^2
+BEAM_RGBA = [0.2, 0.45, 0.8, 1.0]
+
+
+@dataclass
+class BeamHandles:
+    """Names of what a builder made, for the scene to look up after compiling."""
+
+    representation: str
+    link_bodies: List[str]               # body of link j (origin at hinge j)
+    joints: List[str]                    # joint of hinge j
+    tip_body: str
+    tip_site: str = "tip"
+    clamp_body: str = "clamp"
+    payload_body: Optional[str] = None
+    extra: Dict[str, str] = field(default_factory=dict)
+
+
+class BeamBuilder:
+    """Interface: add a discretised beam under the clamp body of a spec."""
+
+    representation: str = ""
+
+    def skeleton_xml(self, layout: BeamLayout, units: UnitSystem) -> str:
+        """XML placed inside the clamp body before parsing (composites must be parsed)."""
+        return ""
+
+    def extensions_xml(self) -> str:
+        return ""
+
+    def build(self, spec: mujoco.MjSpec, layout: BeamLayout, units: UnitSystem) -> BeamHandles:
+        raise NotImplementedError
+
+
+def _mat2quat(R: np.ndarray) -> np.ndarray:
+    q = np.zeros(4)
+    mujoco.mju_mat2Quat(q, np.ascontiguousarray(R, dtype=float).ravel())
+    return q
+
+
+def _set_inertial(body, mass, com_local, inertia, units: UnitSystem):
+    body.explicitinertial = True
+    body.mass = mass / units.mass
+    body.ipos = np.asarray(com_local, dtype=float) / units.length
+    body.inertia = np.asarray(inertia, dtype=float) / units.inertia
+
+
+class HingeChainBuilder(BeamBuilder):
+    """Planar chain: N links, N hinge springs about the local z axis."""
+
+    representation = "hinge"
+
+    def build(self, spec, layout, units):
+        parent = spec.body("clamp")
+        t = layout.thickness / units.length
+        bodies, joints = [], []
+        prev_x = 0.0
+        for j in range(layout.segments):
+            x0, x1 = layout.link_start[j], layout.link_end[j]
+            b = parent.add_body(name=f"link{j}", pos=[(x0 - prev_x) / units.length, 0, 0])
+            b.add_joint(name=f"hinge{j}", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 0, 1],
+                        stiffness=[layout.hinge_stiffness[j] / units.rotational_stiffness, 0, 0],
+                        springref=0.0)
+            half = 0.5 * (x1 - x0) / units.length
+            b.add_geom(name=f"link{j}", type=mujoco.mjtGeom.mjGEOM_BOX,
+                       size=[half, 0.5 * t, 0.5 * layout.link_width[j] / units.length],
+                       pos=[half, 0, 0], rgba=BEAM_RGBA, contype=0, conaffinity=0)
+            _set_inertial(b, layout.link_mass[j], [layout.link_com[j] - x0, 0, 0],
+                          layout.link_inertia[j], units)
+            bodies.append(b.name)
+            joints.append(f"hinge{j}")
+            parent, prev_x = b, x0
+        return BeamHandles("hinge", bodies, joints, tip_body=bodies[-1])
+
+
+class CableBuilder(BeamBuilder):
+    """MuJoCo composite cable with the elasticity plugin (3D bending and twist)."""
+
+    representation = "cable"
+    prefix = "cable"
+
+    def extensions_xml(self) -> str:
+        return '<extension><plugin plugin="mujoco.elasticity.cable"/></extension>'
+
+    def _reference_modulus(self, layout: BeamLayout) -> float:
+        # effective modulus of the section, SI: E_ref * w * t^3 / 12 = EI at the first hinge
+        return 12 * layout.hinge_stiffness[0] * layout.ds / (layout.hinge_width[0] * layout.thickness**3)
+
+    def skeleton_xml(self, layout, units):
+        ds = layout.ds
+        # vertices: -ds/2 (body fixed in the clamp), then the hinges, then the tip
+        xs = np.concatenate([[-0.5 * ds], layout.hinge_x, [layout.length]]) / units.length
+        vertex = " ".join(f"{x:.12g} 0 0" for x in xs)
+        E = self._reference_modulus(layout)
+        G = E / (2 * (1 + layout.poisson_ratio))
+        t = layout.thickness / units.length
+        w = layout.hinge_width[0] / units.length
+        return (
+            f'<composite prefix="{self.prefix}" type="cable" vertex="{vertex}" initial="none">'
+            f'<plugin plugin="mujoco.elasticity.cable">'
+            f'<config key="twist" value="{G / units.pressure:.12g}"/>'
+            f'<config key="bend" value="{E / units.pressure:.12g}"/>'
+            f'<config key="vmax" value="0"/></plugin>'
+            f'<joint kind="main" damping="0"/>'
+            f'<geom type="box" size="1 {0.5 * t:.12g} {0.5 * w:.12g}" rgba="{" ".join(map(str, BEAM_RGBA))}"'
+            f' contype="0" conaffinity="0"/>'
+            f'</composite>')
+
+    def build(self, spec, layout, units):
+        N = layout.segments
+        names = [f"{self.prefix}B_{k}" for k in range(1, N)] + [f"{self.prefix}B_last"]
+        E = self._reference_modulus(layout)
+        t = layout.thickness
+        for j, name in enumerate(names):
+            b = spec.body(name)
+            # per-segment stiffness: the plugin uses E_ref * w_eq * t^3 / 12 for bending
+            # about local z, so the geom width carries EI(x_j)
+            w_eq = 12 * layout.hinge_stiffness[j] * layout.ds / (E * t**3)
+            g = b.geoms[0]
+            g.size = [g.size[0], 0.5 * t / units.length, 0.5 * w_eq / units.length]
+            _set_inertial(b, layout.link_mass[j], [layout.link_com[j] - layout.link_start[j], 0, 0],
+                          layout.link_inertia[j], units)
+        spec.body(f"{self.prefix}B_first").geoms[0].mass = 0.0
+        joints = [spec.body(n).joints[0].name for n in names]
+        # the skin that the composite adds is only a visual for capsules; drop it
+        for skin in list(spec.skins):
+            spec.delete(skin)
+        return BeamHandles("cable", names, joints, tip_body=names[-1],
+                           extra={"fixed_segment": f"{self.prefix}B_first"})
+
+
+BUILDERS: Dict[str, BeamBuilder] = {"hinge": HingeChainBuilder(), "cable": CableBuilder()}
+REPRESENTATIONS = tuple(BUILDERS)
+
+
+def get_builder(representation: str) -> BeamBuilder:
+    try:
+        return BUILDERS[representation]
+    except KeyError:
+        raise UnknownNameError("representation", str(representation), BUILDERS) from None
+
+
+def build_spec(layout: BeamLayout, representation: str = "hinge", orientation: str = "horizontal",
+               payload: Optional[Payload] = None, units: Optional[UnitSystem] = None,
+               gravity: bool = True, model_name: Optional[str] = None):
+    """MjSpec of a clamped beam (internal units) and the handles of its parts.
+
+    Damping, timestep and integrator are set later by :mod:`mjeap.scene`, which derives
+    them from the compiled model.
+    """
+    units = units or UnitSystem()
+    builder = get_builder(representation)
+    R = clamp_rotation(orientation)
+    quat = " ".join(f"{v:.12g}" for v in _mat2quat(R))
+    L = layout.length / units.length
+    t = layout.thickness / units.length
+    w0 = layout.hinge_width[0] / units.length
+    g = GRAVITY / units.acceleration if gravity else 0.0
+    name = model_name or f"{layout.actuator_id}-{representation}-{orientation}"
+    xml = f"""<mujoco model="{name}">
+  <compiler angle="radian" autolimits="true"/>
+  <option gravity="0 0 {-g:.12g}"><flag contact="disable"/></option>
+  <visual><global elevation="-20"/></visual>
+  <statistic center="{0.5 * L * R[0, 0]:.6g} {0.5 * L * R[1, 0]:.6g} {0.5 * L * R[2, 0]:.6g}" extent="{1.5 * L:.6g}"/>
+  {builder.extensions_xml()}
+  <worldbody>
+    <light pos="0 0 {3 * L:.6g}" dir="0 0 -1"/>
+    <body name="clamp" quat="{quat}">
+      <geom name="clamp" type="box" size="{0.08 * L:.6g} {max(3 * t, 0.04 * L):.6g} {0.6 * w0 + 0.02 * L:.6g}"
+            pos="{-0.08 * L:.6g} 0 0" rgba="0.35 0.35 0.35 1" contype="0" conaffinity="0" mass="0"/>
+      {builder.skeleton_xml(layout, units)}
+    </body>
+  </worldbody>
+</mujoco>"""
+    spec = mujoco.MjSpec.from_string(xml)
+    handles = builder.build(spec, layout, units)
+    tip = spec.body(handles.tip_body)
+    tip_local = (layout.tip_x - layout.link_start[-1]) / units.length
+    tip.add_site(name="tip", pos=[tip_local, 0, 0], size=[0.01 * L, 0, 0], rgba=[1, 0.3, 0.1, 1])
+    if layout.extension_length > 0:
+        x0 = (layout.length - layout.link_start[-1]) / units.length
+        ext = tip.add_body(name="extension", pos=[x0, 0, 0])
+        half = 0.5 * layout.extension_length / units.length
+        ext.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=[half, 0.5 * t, 0.5 * layout.link_width[-1] / units.length],
+                     pos=[half, 0, 0], rgba=[0.9, 0.9, 0.85, 1], contype=0, conaffinity=0)
+        m = max(layout.extension_mass, 1e-6 * layout.link_mass[-1])
+        _set_inertial(ext, m, [layout.extension_length / 2, 0, 0],
+                      [m * layout.link_width[-1]**2 / 12, m * layout.extension_length**2 / 12,
+                       m * layout.extension_length**2 / 12], units)
+    if payload is not None:
+        j = layout.link_containing(min(payload.position, layout.length))
+        host = spec.body(handles.link_bodies[j])
+        r = payload.sphere_radius
+        pb = host.add_body(name="payload", pos=[(payload.position - layout.link_start[j]) / units.length, 0, 0])
+        pb.add_geom(name="payload", type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[r / units.length, 0, 0],
+                    rgba=[0.75, 0.2, 0.2, 1], contype=0, conaffinity=0)
+        _set_inertial(pb, payload.mass, [0, 0, 0], [payload.inertia] * 3, units)
+        handles.payload_body = "payload"
+    return spec, handles

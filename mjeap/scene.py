@@ -1,0 +1,351 @@
+"""A compiled, ready-to-step beam scene: model building, damping and timestep choice,
+loads, stepping with divergence checks, and SI read-outs.
+
+Damping and timestep are derived from the compiled model, never tuned by hand:
+
+1. Linearise (``mjeap.modes``) and find the first bending mode omega_1 of the scene
+   (payload and gravity included) and the highest discrete mode.
+2. Joint damping is stiffness-proportional (Rayleigh), b_j = beta k_j with
+   beta = 2 zeta_1 / omega_1, so the first mode has the catalog's damping ratio zeta_1 and
+   mode n has zeta_n = beta omega_n / 2: the stiff discrete modes are overdamped, as
+   material damping does to short wavelengths.
+3. Under ``implicitfast`` joint damping is implicit but stiffness (joint springs and the
+   cable plugin) is explicit, so the step must satisfy the stability limit h_stab of the
+   linearised step map (about beta + sqrt(beta^2 + 4/omega_max^2), i.e. ~2 beta for a fine
+   chain). Under ``discrete`` joint stiffness is implicit too (hinge chain: no limit; the
+   cable plugin stays explicit), at the price of numerical damping ~ omega h / 2.
+4. The default timestep is min(T_1 / 50, h_stab / 2): 50 steps per period of the first
+   mode keeps its period error below 0.1 %, the factor 2 keeps away from the limit, which
+   moves slightly with the large-deflection geometry. A user timestep above h_stab is
+   refused with the limit in the message.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional, Sequence, Union
+
+import mujoco
+import numpy as np
+
+from . import analytical
+from .catalog import Actuator, get_actuator
+from .discretize import BeamLayout, Payload, check_payload, clamp_rotation, discretize
+from .errors import DivergenceError, ParameterError, check_positive, check_range
+from .mjcf import BeamHandles, build_spec, get_builder
+from .modes import linearize, modal_frequencies, stability_limit
+from .units import DEFAULT_UNITS, UnitSystem
+
+STEPS_PER_PERIOD = 50
+STABILITY_SAFETY = 0.5
+SETTLING_DAMPING_RATIO = 0.3
+INTEGRATORS = {"implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
+               "discrete": mujoco.mjtIntegrator.mjINT_DISCRETE}
+DEFAULT_SEGMENTS = 20
+DOF_DAMPING_FIELD = "mjeap_dof_damping"
+
+
+def apply_dof_damping(model: mujoco.MjModel) -> mujoco.MjModel:
+    """Apply the per-dof Rayleigh damping stored in a generated model (cable), in place."""
+    i = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_NUMERIC, DOF_DAMPING_FIELD)
+    if i >= 0:
+        a, n = model.numeric_adr[i], model.numeric_size[i]
+        if n != model.nv:
+            raise ParameterError(DOF_DAMPING_FIELD, n, f"{model.nv} values (one per dof)")
+        model.dof_damping[:] = model.numeric_data[a:a + n]
+    return model
+
+
+def load_mjcf(path: str) -> mujoco.MjModel:
+    """Load a model written by mjeap (``assets/mjcf``) with its per-dof damping applied."""
+    return apply_dof_damping(mujoco.MjModel.from_xml_path(str(path)))
+
+
+@dataclass(frozen=True)
+class TimestepChoice:
+    """How the timestep and damping were chosen (SI)."""
+
+    timestep: float               # s
+    stability_limit: float        # s (inf: none)
+    accuracy_limit: float         # s, T_1 / STEPS_PER_PERIOD
+    first_frequency: float        # Hz, scene's first bending mode (gravity included)
+    highest_frequency: float      # Hz, highest discrete mode (elastic)
+    damping_ratio: float          # zeta_1
+    rayleigh_beta: float          # s
+    integrator: str
+    buckled: bool                 # reference configuration unstable under gravity
+    reason: str
+
+    def as_dict(self) -> dict:
+        return dict(self.__dict__)
+
+
+class Scene:
+    """A catalog actuator as a MuJoCo scene. Inputs and outputs in SI.
+
+    Parameters: ``actuator`` (catalog id or :class:`Actuator`), ``representation``
+    ('hinge' | 'cable'), ``segments`` (>= 2), ``orientation`` ('horizontal' | 'up' |
+    'down'), ``payload`` (:class:`Payload` or 'MASS@POSITION'), ``units`` (internal
+    :class:`UnitSystem`), ``timestep`` (s, default from the model), ``integrator``
+    ('implicitfast' | 'discrete'), ``damping_ratio`` (first-mode, default from the
+    catalog), ``gravity`` (bool).
+    """
+
+    def __init__(self, actuator: Union[str, Actuator], representation: str = "hinge",
+                 segments: int = DEFAULT_SEGMENTS, orientation: str = "horizontal",
+                 payload: Union[Payload, str, None] = None, units: Optional[UnitSystem] = None,
+                 timestep: Optional[float] = None, integrator: str = "implicitfast",
+                 damping_ratio: Optional[float] = None, gravity: bool = True):
+        self.actuator = get_actuator(actuator)
+        get_builder(representation)
+        clamp_rotation(orientation)
+        if integrator not in INTEGRATORS:
+            raise ParameterError("integrator", integrator, f"one of {', '.join(INTEGRATORS)}")
+        if isinstance(payload, str):
+            payload = Payload.parse(payload)
+        self.units = units or DEFAULT_UNITS
+        self.representation, self.orientation, self.payload = representation, orientation, payload
+        self.integrator = integrator
+        self.layout: BeamLayout = discretize(self.actuator, segments)
+        check_payload(payload, self.layout)
+        zeta = self.actuator.damping_ratio.value if damping_ratio is None else \
+            check_range("damping_ratio", damping_ratio, 0.0, 10.0)
+        self.rotation = clamp_rotation(orientation)
+
+        self.spec, self.handles = build_spec(self.layout, representation, orientation, payload,
+                                             self.units, gravity)
+        self.spec.option.integrator = INTEGRATORS[integrator]
+        self.spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_AUTORESET
+        self.choice = self._choose_timestep_and_damping(zeta, timestep)
+        self.model = apply_dof_damping(self.spec.compile())
+        self.data = mujoco.MjData(self.model)
+        self._ids()
+        self._tip_force_world = np.zeros(3)
+        self._tip_moment = 0.0
+        self.reset()
+
+    # ------------------------------------------------------------------ construction
+    def _joint_stiffness_per_joint(self) -> np.ndarray:
+        return self.layout.hinge_stiffness / self.units.rotational_stiffness
+
+    def _choose_timestep_and_damping(self, zeta: float, timestep: Optional[float]) -> TimestepChoice:
+        u = self.units
+        model = self.spec.compile()
+        self.linearization = lin = linearize(model)
+        w2_tot = modal_frequencies(lin, with_gravity=True)
+        w2_el = modal_frequencies(lin, with_gravity=False)
+        buckled = bool(w2_tot[0] <= 0)
+        w1 = np.sqrt(w2_tot[0] if not buckled else w2_el[0])
+        wmax = np.sqrt(w2_el[-1])
+        beta = 2 * zeta / w1
+        # Rayleigh damping D = beta K per degree of freedom. A ball joint takes one scalar
+        # damping in MJCF, so the cable's per-dof values (bending, in-plane, twist) travel in
+        # a custom numeric field that load_mjcf() and the scene apply after compiling.
+        dof_damping = beta * np.clip(np.diag(lin.K_elastic), 0.0, None)
+        kj = self._joint_stiffness_per_joint()
+        for j, name in enumerate(self.handles.joints):
+            self.spec.joint(name).damping = [beta * kj[j], 0, 0]
+        if self.representation != "hinge":
+            self.spec.add_numeric(name=DOF_DAMPING_FIELD, data=list(dof_damping))
+        T1 = 2 * np.pi / w1
+        h_stab = stability_limit(lin, dof_damping, self.integrator, h_max=T1)
+        h_acc = T1 / STEPS_PER_PERIOD
+        if timestep is None:
+            h = min(h_acc, STABILITY_SAFETY * h_stab)
+            reason = (f"min(T1/{STEPS_PER_PERIOD} = {h_acc * u.time:.3g} s, "
+                      f"{STABILITY_SAFETY} x stability limit {h_stab * u.time:.3g} s)")
+        else:
+            h = check_positive("timestep", timestep, "s") / u.time
+            if h > h_stab:
+                raise ParameterError(
+                    "timestep", timestep,
+                    f"a timestep <= {h_stab * u.time:.4g} s",
+                    f"stability limit of {self.actuator.id} ({self.representation}, {self.layout.segments} "
+                    f"segments) under {self.integrator}: highest bending mode {wmax / u.time / 2 / np.pi:.4g} Hz "
+                    f"with explicit stiffness, Rayleigh damping beta = {beta * u.time:.3g} s")
+            reason = "given by the user"
+        self.spec.option.timestep = h
+        return TimestepChoice(
+            timestep=h * u.time, stability_limit=h_stab * u.time, accuracy_limit=h_acc * u.time,
+            first_frequency=w1 / u.time / (2 * np.pi), highest_frequency=wmax / u.time / (2 * np.pi),
+            damping_ratio=zeta, rayleigh_beta=beta * u.time, integrator=self.integrator,
+            buckled=buckled, reason=reason)
+
+    def _ids(self):
+        m, h = self.model, self.handles
+        body = lambda n: mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, n)  # noqa: E731
+        self.clamp_id = body(h.clamp_body)
+        self.link_ids = np.array([body(n) for n in h.link_bodies])
+        self.tip_body_id = body(h.tip_body)
+        self.tip_site_id = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, h.tip_site)
+        self.payload_id = body(h.payload_body) if h.payload_body else -1
+        self.joint_ids = np.array([mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, n) for n in h.joints])
+        self.joint_qpos = m.jnt_qposadr[self.joint_ids]
+        self.joint_dof = m.jnt_dofadr[self.joint_ids]
+        # offset from the tip body's centre of mass to the tip site, body frame
+        self._tip_offset = m.site_pos[self.tip_site_id] - m.body_ipos[self.tip_body_id]
+
+    # ------------------------------------------------------------------ state
+    @property
+    def timestep(self) -> float:
+        """Timestep (s)."""
+        return self.choice.timestep
+
+    @property
+    def time(self) -> float:
+        """Simulated time (s)."""
+        return self.data.time * self.units.time
+
+    def reset(self, curvature: float = 0.0) -> None:
+        """Reset to rest; ``curvature`` (1/m) starts the beam as a uniform arc of that
+        curvature (seed 000 starts each experiment from a measured curvature)."""
+        mujoco.mj_resetData(self.model, self.data)
+        if curvature:
+            self.set_hinge_angles(np.full(self.layout.segments, curvature * self.layout.ds))
+        mujoco.mj_forward(self.model, self.data)
+        self._step_count = 0
+
+    def set_hinge_angles(self, angles: Sequence[float]) -> None:
+        """Set the bending angle (rad) of every hinge about the hinge axis, velocities zero."""
+        a = np.asarray(angles, dtype=float)
+        if a.shape != (self.layout.segments,):
+            raise ParameterError("angles", a.shape, f"an array of {self.layout.segments} angles")
+        if self.representation == "hinge":
+            self.data.qpos[self.joint_qpos] = a
+        else:
+            for adr, th in zip(self.joint_qpos, a):
+                self.data.qpos[adr:adr + 4] = [np.cos(th / 2), 0, 0, np.sin(th / 2)]
+        self.data.qvel[:] = 0
+        mujoco.mj_forward(self.model, self.data)
+
+    def hinge_angles(self) -> np.ndarray:
+        """Bending angle (rad) of every hinge about the hinge axis."""
+        q = self.data.qpos
+        if self.representation == "hinge":
+            return q[self.joint_qpos].copy()
+        out = np.empty(len(self.joint_qpos))
+        for i, adr in enumerate(self.joint_qpos):
+            w, _, _, z = q[adr:adr + 4]
+            out[i] = 2 * np.arctan2(z, w)
+        return out
+
+    # ------------------------------------------------------------------ loads
+    def set_tip_force(self, force: Union[float, Sequence[float]]) -> None:
+        """Dead load at the tip point, N. A scalar is transverse (along the deflection
+        axis y of the clamp frame); a 3-vector is (axial, transverse, out-of-plane) in the
+        clamp frame."""
+        f = np.array([0.0, float(force), 0.0]) if np.isscalar(force) else np.asarray(force, dtype=float)
+        if f.shape != (3,) or not np.all(np.isfinite(f)):
+            raise ParameterError("force", force, "a finite scalar or 3-vector in N")
+        self._tip_force_world = self.rotation @ f / self.units.force
+        self._apply_loads()
+
+    def set_tip_moment(self, moment: float) -> None:
+        """Couple at the tip about the hinge axis, N m (positive bends toward +y)."""
+        m = float(moment)
+        if not np.isfinite(m):
+            raise ParameterError("moment", moment, "a finite number in N m")
+        self._tip_moment = m / self.units.moment
+        self._apply_loads()
+
+    def _apply_loads(self) -> None:
+        d, b = self.data, self.tip_body_id
+        f = self._tip_force_world
+        torque = self.rotation[:, 2] * self._tip_moment
+        if f.any():
+            arm = d.xmat[b].reshape(3, 3) @ self._tip_offset
+            torque = torque + np.cross(arm, f)
+        d.xfrc_applied[b, :3] = f
+        d.xfrc_applied[b, 3:] = torque
+
+    # ------------------------------------------------------------------ stepping
+    def step(self, n: int = 1) -> None:
+        """Advance ``n`` steps; raises :class:`DivergenceError` if the state blows up."""
+        m, d = self.model, self.data
+        if self._tip_force_world.any():
+            for _ in range(n):
+                self._apply_loads()
+                mujoco.mj_step(m, d)
+        else:
+            mujoco.mj_step(m, d, nstep=n)
+        self._step_count += n
+        self.check_finite()
+
+    def run(self, duration: float) -> None:
+        """Advance by ``duration`` seconds (rounded to whole steps)."""
+        n = int(round(check_positive("duration", duration, "s") / self.timestep))
+        self.step(max(n, 1))
+
+    def check_finite(self) -> None:
+        d = self.data
+        bad = d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number > 0 or not np.all(np.isfinite(d.qpos)) \
+            or not np.all(np.isfinite(d.qvel))
+        if bad:
+            c = self.choice
+            raise DivergenceError(
+                f"{self.actuator.id} ({self.representation}) diverged by step {self._step_count} "
+                f"(t = {self.time:.6g} s): timestep {c.timestep:.4g} s, stability limit "
+                f"{c.stability_limit:.4g} s set by the highest bending mode ({c.highest_frequency:.4g} Hz) "
+                f"under {c.integrator}" + ("; the reference configuration is buckled under gravity"
+                                          if c.buckled else "") + ". Reduce the timestep or the load.")
+
+    def settle(self, tol: float = 1e-7, max_periods: int = 400) -> int:
+        """Run to static equilibrium under the current loads with extra damping (first-mode
+        damping ratio 0.3), returning the number of steps; the tip must move by less than
+        ``tol`` x L over one first-mode period. Restores the scene's damping afterwards."""
+        m = self.model
+        saved = m.dof_damping.copy()
+        m.dof_damping[:] = saved * (SETTLING_DAMPING_RATIO / max(self.choice.damping_ratio, 1e-9))
+        period = max(1, int(round(1.0 / self.choice.first_frequency / self.timestep)))
+        steps, last = 0, self.tip_position()
+        try:
+            for _ in range(max_periods):
+                self.step(period)
+                steps += period
+                now = self.tip_position()
+                if np.linalg.norm(now - last) < tol * self.layout.length:
+                    return steps
+                last = now
+        finally:
+            m.dof_damping[:] = saved
+        raise DivergenceError(f"{self.actuator.id}: did not settle within {max_periods} periods "
+                              f"(tip still moving by {np.linalg.norm(now - last):.3g} m per period)")
+
+    # ------------------------------------------------------------------ read-outs (SI)
+    def _to_clamp(self, p_world: np.ndarray) -> np.ndarray:
+        return (p_world - self.data.xpos[self.clamp_id]) @ self.rotation * self.units.length
+
+    def tip_position(self) -> np.ndarray:
+        """Tip point in the clamp frame (axial x, deflection y, out-of-plane z), m."""
+        return self._to_clamp(self.data.site_xpos[self.tip_site_id])
+
+    def tip_angle(self) -> float:
+        """Rotation of the tip about the hinge axis relative to the clamp, rad."""
+        R = self.rotation.T @ self.data.xmat[self.tip_body_id].reshape(3, 3)
+        return float(np.arctan2(R[1, 0], R[0, 0]))
+
+    def tip_curvature(self) -> float:
+        """Curvature (1/m) of the arc through clamp and tip, tangent at the clamp (seed 000)."""
+        p = self.tip_position()
+        return analytical.arc_curvature(p[0], p[1])
+
+    def centreline(self) -> np.ndarray:
+        """Clamp, hinges and tip in the clamp frame, (N + 2, 3), m."""
+        pts = np.vstack([self.data.xpos[self.clamp_id], self.data.xpos[self.link_ids],
+                         self.data.site_xpos[self.tip_site_id]])
+        return self._to_clamp(pts)
+
+    def payload_position(self) -> Optional[np.ndarray]:
+        """Payload centre in the clamp frame (m), or None."""
+        return None if self.payload_id < 0 else self._to_clamp(self.data.xpos[self.payload_id])
+
+    # ------------------------------------------------------------------ output
+    def to_xml(self) -> str:
+        """The scene as MJCF text (internal units, as compiled)."""
+        return self.spec.to_xml()
+
+    def summary(self) -> dict:
+        c = self.choice
+        return {"actuator": self.actuator.id, "representation": self.representation,
+                "segments": self.layout.segments, "orientation": self.orientation,
+                "payload_kg": None if self.payload is None else self.payload.mass,
+                "units": self.units.describe(), **c.as_dict()}
