@@ -22,7 +22,8 @@ __all__ = [
     "tip_force_deflection", "tip_moment_deflection", "uniform_load_deflection",
     "deflection_shape_tip_force", "elastica_tip_force", "Elastica", "arc_tip_moment",
     "natural_frequencies", "lateral_stiffness", "buckling_load", "arc_curvature",
-    "multilayer_section", "SectionLayer", "SectionProperties",
+    "multilayer_section", "SectionLayer", "SectionProperties", "lateral_stiffness_column",
+    "critical_tip_load",
 ]
 
 
@@ -73,37 +74,35 @@ def elastica_tip_force(P: float, L: float, EI: float, axial: float = 0.0,
 
     ``P`` is the force component perpendicular to the undeformed axis (N), ``axial`` the
     component along it (N, > 0 pulls the tip away from the clamp), ``tip_moment`` a tip
-    couple (N m). Equations in arc length s: x' = cos(theta), y' = sin(theta),
-    EI theta'' = -(P cos(theta) - axial sin(theta)); theta(0) = 0, EI theta'(L) = tip_moment.
-    Continuation in the load from the small-deflection solution keeps the solver on the
-    primary branch.
+    couple (N m). In xi = s / L with p = P L^2/EI, a = axial L^2/EI, m = M L/EI:
+    theta'' = -(p cos(theta) - a sin(theta)), theta(0) = 0, theta'(1) = m; x' = cos(theta),
+    y' = sin(theta). Continuation in the load from the unloaded beam keeps the solver on
+    the primary branch.
     """
     check_positive("L", L, "m")
     check_positive("EI", EI, "N m^2")
-    s = np.linspace(0.0, L, n)
+    xi = np.linspace(0.0, 1.0, n)
+    p0, a0, m0 = P * L**2 / EI, axial * L**2 / EI, tip_moment * L / EI
 
     def solve(frac, guess):
-        p, a, m = frac * P, frac * axial, frac * tip_moment
+        p, a, m = frac * p0, frac * a0, frac * m0
 
         def rhs(_s, u):
-            th, k = u[0], u[1]
-            return np.vstack([k, -(p * np.cos(th) - a * np.sin(th)) / EI, np.cos(th), np.sin(th)])
+            th = u[0]
+            return np.vstack([u[1], -(p * np.cos(th) - a * np.sin(th)), np.cos(th), np.sin(th)])
 
-        def bc(u0, uL):
-            return np.array([u0[0], uL[1] - m / EI, u0[2], u0[3]])
+        def bc(u0, u1):
+            return np.array([u0[0], u1[1] - m, u0[2], u0[3]])
 
-        sol = integrate.solve_bvp(rhs, bc, s, guess, tol=1e-9, max_nodes=200000)
+        sol = integrate.solve_bvp(rhs, bc, xi, guess, tol=1e-10, max_nodes=100000)
         if not sol.success:
             raise RuntimeError(f"elastica BVP did not converge at load fraction {frac}: {sol.message}")
-        return sol.sol(s)
+        return sol.sol(xi)
 
-    # initial guess: small-deflection shape
-    th0 = (P * (L * s - s**2 / 2) + tip_moment * s) / EI * 1e-3
-    guess = np.vstack([th0, np.gradient(th0, s), s, np.zeros_like(s)])
-    u = guess
+    u = np.vstack([np.zeros_like(xi), np.zeros_like(xi), xi, np.zeros_like(xi)])
     for frac in np.linspace(0.1, 1.0, 10):
         u = solve(frac, u)
-    return Elastica(s=s, x=u[2], y=u[3], theta=u[0])
+    return Elastica(s=xi * L, x=u[2] * L, y=u[3] * L, theta=u[0])
 
 
 def arc_tip_moment(M: float, L: float, EI: float) -> Tuple[float, float, float]:
@@ -176,3 +175,55 @@ def lateral_stiffness(L: float, EI: float, axial: float = 0.0) -> float:
     if a * L >= np.pi / 2:
         raise ParameterError("axial", axial, f"a compression below the Euler load {buckling_load(L, EI):.6g} N")
     return -axial * a / (np.tan(a * L) - a * L)
+
+
+def lateral_stiffness_column(L: float, EI: float, tip_tension: float, weight_per_length: float = 0.0) -> float:
+    """Lateral tip stiffness (N/m) of a cantilever column with axial tension
+    T(x) = tip_tension + weight_per_length (L - x) (N; negative = compression).
+
+    Linear BVP EI w'''' = (T w')', w(0) = w'(0) = 0, w''(L) = 0 and the tip shear
+    -EI w'''(L) + T(L) w'(L) = F, solved with scipy in xi = x / L, W = w EI / (F L^3).
+    Unlike :func:`lateral_stiffness` it includes the beam's own weight. Returns F / w(L);
+    k passes continuously through 0 at the buckling load and is negative beyond.
+    """
+    tau_tip = tip_tension * L**2 / EI
+    kq = weight_per_length * L**3 / EI
+    xi = np.linspace(0.0, 1.0, 101)
+
+    def rhs(s, u):  # u = [W, W', W'', W''']
+        return np.vstack([u[1], u[2], u[3], -kq * u[1] + (tau_tip + kq * (1 - s)) * u[2]])
+
+    def bc(u0, u1):
+        return np.array([u0[0], u0[1], u1[2], -u1[3] + tau_tip * u1[1] - 1.0])
+
+    guess = np.vstack([xi**2 * (3 - xi) / 6, xi * (2 - xi) / 2, 1 - xi, -np.ones_like(xi)])
+    sol = integrate.solve_bvp(rhs, bc, xi, guess, tol=1e-8, max_nodes=100000)
+    if not sol.success:
+        raise RuntimeError(f"column BVP did not converge: {sol.message}")
+    return EI / (L**3 * float(sol.sol(1.0)[0]))
+
+
+def critical_tip_load(L: float, EI: float, weight_per_length: float = 0.0) -> float:
+    """Compressive dead tip load (N) at which a cantilever standing up under its own
+    weight buckles; pi^2 EI / (4 L^2) when weightless.
+
+    Shooting on the homogeneous column equation (scipy solve_ivp): the two solutions with
+    W(0) = W'(0) = 0 must satisfy W''(1) = 0 and -W'''(1) + tau(1) W'(1) = 0 together,
+    i.e. their 2 x 2 determinant vanishes at the critical load.
+    """
+    Pe = buckling_load(L, EI)
+    kq = -weight_per_length * L**3 / EI
+
+    def det(P):
+        tau_tip = -P * L**2 / EI
+
+        def rhs(s, u):
+            return [u[1], u[2], u[3], -kq * u[1] + (tau_tip + kq * (1 - s)) * u[2]]
+
+        cols = []
+        for init in ([0, 0, 1, 0], [0, 0, 0, 1]):
+            u = integrate.solve_ivp(rhs, (0, 1), init, rtol=1e-11, atol=1e-13).y[:, -1]
+            cols.append([u[2], -u[3] + tau_tip * u[1]])
+        return cols[0][0] * cols[1][1] - cols[0][1] * cols[1][0]
+
+    return optimize.brentq(det, 0.5 * Pe, 1.5 * Pe, xtol=1e-12 * Pe)

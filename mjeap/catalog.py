@@ -133,12 +133,19 @@ class Actuator:
         return self.mass.value if self.mass is not None else self._layered_mass()
 
 
-def _check(act: Actuator) -> Actuator:
+def validate_actuator(act: Actuator) -> Actuator:
+    """Raise ParameterError naming the first non-positive size or property of ``act``."""
     check_positive(f"{act.id}.planform.length", act.planform.length, "m")
     check_positive(f"{act.id}.planform.base_width", act.planform.base_width, "m")
     check_positive(f"{act.id}.planform.tip_width", act.planform.tip_width, "m")
     for l in act.layers:
-        check_positive(f"{act.id}.{l.name}.thickness", l.thickness, "m")
+        for f, unit in (("thickness", "m"), ("youngs_modulus", "Pa"), ("density", "kg/m^3")):
+            check_positive(f"{act.id}.{l.name}.{f}", getattr(l, f), unit)
+        if l.width is not None:
+            check_positive(f"{act.id}.{l.name}.width", l.width, "m")
+    for o in ("flexural_rigidity", "mass"):
+        if getattr(act, o) is not None:
+            check_positive(f"{act.id}.{o}", getattr(act, o).value, getattr(act, o).unit)
     return act
 
 
@@ -271,7 +278,7 @@ PZT_HAMR_LARGE = _pzt("pzt-hamr-large", "PZT-5H bimorph Type I (HAMR, large)", 1
 PZT_HAMR_SMALL = _pzt("pzt-hamr-small", "PZT-5H bimorph Type II (HAMR, small)", 1.75e-3, 5.25e-3, 9.2e-3, "Type II")
 PZT_ROBOBEE = _pzt("pzt-robobee", "PZT-5H bimorph Type III (RoboBee)", 0.5e-3, 1.75e-3, 9e-3, "Type III")
 
-CATALOG: Dict[str, Actuator] = {a.id: _check(a) for a in (
+CATALOG: Dict[str, Actuator] = {a.id: validate_actuator(a) for a in (
     PEDOT_MICRO, PPY_TRILAYER, PVDF_60, PVDF_60_HALF, PVDF_130,
     PZT_HAMR_LARGE, PZT_HAMR_SMALL, PZT_ROBOBEE)}
 
@@ -279,7 +286,7 @@ CATALOG: Dict[str, Actuator] = {a.id: _check(a) for a in (
 def get_actuator(name: str) -> Actuator:
     """Catalog entry by id; an unknown id raises with the closest ids suggested."""
     if isinstance(name, Actuator):
-        return name
+        return validate_actuator(name)
     try:
         return CATALOG[name]
     except KeyError:

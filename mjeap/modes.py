@@ -29,16 +29,19 @@ class Linearization:
         return self.K_elastic + self.K_gravity
 
 
-def linearize(model: mujoco.MjModel, eps: float = 1e-6) -> Linearization:
-    """Mass and stiffness matrices at qpos0 by central differences of MuJoCo's forces."""
+def linearize(model: mujoco.MjModel, eps: float = 1e-6, qpos=None) -> Linearization:
+    """Mass and stiffness matrices at ``qpos`` (default qpos0) by central differences of
+    MuJoCo's forces (the tangent stiffness there, whether or not it is an equilibrium)."""
     d = mujoco.MjData(model)
     nv = model.nv
+    q_ref = model.qpos0.copy() if qpos is None else np.asarray(qpos, dtype=float).copy()
+    d.qpos[:] = q_ref
     mujoco.mj_forward(model, d)
     M = np.zeros((nv, nv))
     mujoco.mj_fullM(model, d, M)
 
     def forces(dq):
-        q = model.qpos0.copy()
+        q = q_ref.copy()
         mujoco.mj_integratePos(model, q, dq, 1.0)
         d.qpos[:] = q
         d.qvel[:] = 0
@@ -70,6 +73,16 @@ def modal_frequencies(lin: Linearization, with_gravity: bool = True) -> np.ndarr
     return scipy.linalg.eigh(K, lin.M, eigvals_only=True)
 
 
+def _stable_part(K: np.ndarray, M: np.ndarray) -> np.ndarray:
+    """K with its negative modes (physical instabilities, e.g. away from equilibrium) removed:
+    those grow at any timestep and say nothing about the integrator's limit."""
+    lam, phi = scipy.linalg.eigh(K, M)
+    if lam.min() >= 0:
+        return K
+    Mphi = M @ phi
+    return (Mphi * np.clip(lam, 0.0, None)) @ Mphi.T
+
+
 def spectral_radius(lin: Linearization, damping: np.ndarray, h: float, integrator: str) -> float:
     """Spectral radius of MuJoCo's linearised one-step map at timestep ``h``.
 
@@ -78,7 +91,7 @@ def spectral_radius(lin: Linearization, damping: np.ndarray, h: float, integrato
     (M + h D + h^2 K_i) v+ = M v - h (K_i + K_e) x.
     Gravity stiffness is left out: it sets the physics (buckling), not the numerics.
     """
-    M, K = lin.M, lin.K_elastic
+    M, K = lin.M, _stable_part(lin.K_elastic, lin.M)
     Ki = lin.K_joint if integrator == "discrete" else np.zeros_like(K)
     A = M + h * np.diag(damping) + h * h * Ki
     AinvK = np.linalg.solve(A, K)

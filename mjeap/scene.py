@@ -41,6 +41,9 @@ SETTLING_DAMPING_RATIO = 0.3
 INTEGRATORS = {"implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
                "discrete": mujoco.mjtIntegrator.mjINT_DISCRETE}
 DEFAULT_SEGMENTS = 20
+#: tip angle (rad) of the uniform arc at which the cable's stability limit is checked
+#: besides the straight beam; seed 000's actuator bends to about 1.8 rad
+DEFAULT_MAX_BEND = 2.0
 DOF_DAMPING_FIELD = "mjeap_dof_damping"
 
 
@@ -87,14 +90,16 @@ class Scene:
     'down'), ``payload`` (:class:`Payload` or 'MASS@POSITION'), ``units`` (internal
     :class:`UnitSystem`), ``timestep`` (s, default from the model), ``integrator``
     ('implicitfast' | 'discrete'), ``damping_ratio`` (first-mode, default from the
-    catalog), ``gravity`` (bool).
+    catalog), ``gravity`` (bool), ``max_bend`` (rad: tip angle up to which the cable's
+    timestep is checked for stability; the hinge chain needs none).
     """
 
     def __init__(self, actuator: Union[str, Actuator], representation: str = "hinge",
                  segments: int = DEFAULT_SEGMENTS, orientation: str = "horizontal",
                  payload: Union[Payload, str, None] = None, units: Optional[UnitSystem] = None,
                  timestep: Optional[float] = None, integrator: str = "implicitfast",
-                 damping_ratio: Optional[float] = None, gravity: bool = True):
+                 damping_ratio: Optional[float] = None, gravity: bool = True,
+                 max_bend: float = DEFAULT_MAX_BEND):
         self.actuator = get_actuator(actuator)
         get_builder(representation)
         clamp_rotation(orientation)
@@ -105,6 +110,7 @@ class Scene:
         self.units = units or DEFAULT_UNITS
         self.representation, self.orientation, self.payload = representation, orientation, payload
         self.integrator = integrator
+        self.max_bend = check_range("max_bend", max_bend, 0.0, 2 * np.pi, "rad")
         self.layout: BeamLayout = discretize(self.actuator, segments)
         check_payload(payload, self.layout)
         zeta = self.actuator.damping_ratio.value if damping_ratio is None else \
@@ -129,7 +135,16 @@ class Scene:
 
     def _choose_timestep_and_damping(self, zeta: float, timestep: Optional[float]) -> TimestepChoice:
         u = self.units
-        model = self.spec.compile()
+        try:
+            model = self.spec.compile()
+        except ValueError as e:
+            if "mjMINVAL" not in str(e):
+                raise
+            raise ParameterError(
+                "units", u, "units in which segment masses and inertias exceed MuJoCo's 1e-15 floor",
+                f"{self.actuator.id}: smallest segment mass {self.layout.link_mass.min() / u.mass:.3g} and "
+                f"inertia {self.layout.link_inertia.min() / u.inertia:.3g} in these units; use e.g. the default "
+                f"(mm, mg, ms). MuJoCo said: {str(e).splitlines()[0]}") from None
         self.linearization = lin = linearize(model)
         w2_tot = modal_frequencies(lin, with_gravity=True)
         w2_el = modal_frequencies(lin, with_gravity=False)
@@ -148,6 +163,13 @@ class Scene:
             self.spec.add_numeric(name=DOF_DAMPING_FIELD, data=list(dof_damping))
         T1 = 2 * np.pi / w1
         h_stab = stability_limit(lin, dof_damping, self.integrator, h_max=T1)
+        if self.representation != "hinge":
+            # the cable's tangent stiffness stops being diagonal in the joint coordinates
+            # once bent (the stiff in-plane direction couples into twist), so diagonal
+            # damping no longer damps it: check the design bend too
+            bent = self._uniform_arc_qpos(model, self.max_bend)
+            h_stab = min(h_stab, stability_limit(linearize(model, qpos=bent), dof_damping,
+                                                 self.integrator, h_max=T1))
         h_acc = T1 / STEPS_PER_PERIOD
         if timestep is None:
             h = min(h_acc, STABILITY_SAFETY * h_stab)
@@ -169,6 +191,17 @@ class Scene:
             first_frequency=w1 / u.time / (2 * np.pi), highest_frequency=wmax / u.time / (2 * np.pi),
             damping_ratio=zeta, rayleigh_beta=beta * u.time, integrator=self.integrator,
             buckled=buckled, reason=reason)
+
+    def _uniform_arc_qpos(self, model: mujoco.MjModel, tip_angle: float) -> np.ndarray:
+        q = model.qpos0.copy()
+        th = tip_angle / self.layout.segments
+        for j in self.handles.joints:
+            adr = model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j)]
+            if self.representation == "hinge":
+                q[adr] = th
+            else:
+                q[adr:adr + 4] = [np.cos(th / 2), 0, 0, np.sin(th / 2)]
+        return q
 
     def _ids(self):
         m, h = self.model, self.handles

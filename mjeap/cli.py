@@ -1,0 +1,162 @@
+"""The ``mjeap`` command line."""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from pathlib import Path
+from typing import List, Optional
+
+from .errors import MjeapError
+
+
+def _fmt(v: float) -> str:
+    return f"{v:.4g}"
+
+
+def cmd_list(args) -> int:
+    from .catalog import CATALOG
+    width = max(len(k) for k in CATALOG)
+    for a in CATALOG.values():
+        print(f"{a.id:<{width}}  {a.title}  [{a.document}]")
+    return 0
+
+
+def describe(name: str) -> dict:
+    """Every parameter of a catalog actuator with unit and provenance, plus derived values."""
+    from . import analytical
+    from .catalog import get_actuator
+    from .scene import Scene
+    a = get_actuator(name)
+    layers = []
+    for l in a.layers:
+        layers.append({
+            "name": l.name, "material": l.material,
+            "thickness": (l.thickness, "m", l.provenance("thickness")),
+            "width": (l.width if l.width is not None else "planform", "m", l.provenance("width")),
+            "youngs_modulus": (l.youngs_modulus, "Pa", l.provenance("youngs_modulus")),
+            "poisson_ratio": (l.poisson_ratio, "-", l.provenance("poisson_ratio")),
+            "density": (l.density, "kg/m^3", l.provenance("density")),
+        })
+    p = a.planform
+    sec = a.section_at(0.0)
+    EI0 = float(a.flexural_rigidity_at(0.0)[0])
+    mu = a.total_mass() / a.length
+    uniform = p.base_width == p.tip_width
+    f1_formula = float(analytical.natural_frequencies(a.length, EI0, mu, n=1)[0]) if uniform else None
+    scene = Scene(a)
+    c = scene.choice
+    return {
+        "id": a.id, "title": a.title, "document": a.document, "layers": layers,
+        "planform": {"length": (p.length, "m", p.source), "base_width": (p.base_width, "m", p.source),
+                     "tip_width": (p.tip_width, "m", p.source),
+                     "extension_length": (p.extension_length, "m", p.extension_source),
+                     "extension_mass": (p.extension_mass, "kg", p.extension_source)},
+        "overrides": {k: (getattr(a, k).value, getattr(a, k).unit, getattr(a, k).source)
+                      for k in ("flexural_rigidity", "mass") if getattr(a, k) is not None},
+        "damping_ratio": (a.damping_ratio.value, "-", a.damping_ratio.source),
+        "voltage_range": (list(a.voltage_range), "V", a.voltage_source),
+        "plane_strain": (a.plane_strain, "-", a.plane_strain_source),
+        "derived": {
+            "flexural_rigidity_clamp": (EI0, "N m^2", "identified" if a.flexural_rigidity else "multilayer_section"),
+            "flexural_rigidity_tip": (float(a.flexural_rigidity_at(a.length)[0]), "N m^2", ""),
+            "neutral_axis": (sec.neutral_axis, "m from the bottom face", "multilayer_section"),
+            "thickness": (a.thickness, "m", ""),
+            "mass": (a.total_mass(), "kg", "measured" if a.mass else "layers x planform"),
+            "first_frequency_uniform_beam": (f1_formula, "Hz", "Euler-Bernoulli" if uniform else "tapered: n/a"),
+            "first_frequency_model": (c.first_frequency, "Hz", f"MuJoCo hinge chain, {scene.layout.segments} segments"),
+            "highest_frequency_model": (c.highest_frequency, "Hz", "highest discrete mode"),
+            "stability_limit": (c.stability_limit, "s", f"{c.integrator}, Rayleigh beta = {c.rayleigh_beta:.3g} s"),
+            "default_timestep": (c.timestep, "s", c.reason),
+        },
+    }
+
+
+def cmd_show(args) -> int:
+    d = describe(args.name)
+    if args.json:
+        print(json.dumps(d, indent=2, default=str))
+        return 0
+    print(f"{d['id']}: {d['title']}\n  source: {d['document']}\n\nlayers (bottom to top):")
+    for l in d["layers"]:
+        print(f"  {l['name']} ({l['material']})")
+        for k in ("thickness", "width", "youngs_modulus", "poisson_ratio", "density"):
+            v, u, s = l[k]
+            print(f"    {k:<16} {v if isinstance(v, str) else _fmt(v):>12} {u:<7} {s}")
+
+    def block(title, items):
+        print(f"\n{title}:")
+        for k, (v, u, s) in items.items():
+            vs = "-" if v is None else (_fmt(v) if isinstance(v, float) else str(v))
+            print(f"  {k:<30} {vs:>12} {u:<8} {s}")
+
+    block("planform", d["planform"])
+    if d["overrides"]:
+        block("identified values (override the layers)", d["overrides"])
+    block("model parameters", {k: d[k] for k in ("damping_ratio", "voltage_range", "plane_strain")})
+    block("derived", d["derived"])
+    return 0
+
+
+def _scene_from_args(args):
+    from .discretize import Payload
+    from .scene import Scene
+    payload = Payload.parse(args.payload) if args.payload else None
+    return Scene(args.name, representation=args.representation, segments=args.segments,
+                 orientation=args.orientation, payload=payload, timestep=args.timestep,
+                 integrator=args.integrator)
+
+
+def cmd_mjcf(args) -> int:
+    scene = _scene_from_args(args)
+    xml = scene.to_xml()
+    if args.output in (None, "-"):
+        sys.stdout.write(xml)
+    else:
+        Path(args.output).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.output).write_text(xml)
+        c = scene.choice
+        print(f"wrote {args.output}: {scene.representation}, {scene.layout.segments} segments, "
+              f"timestep {c.timestep:.3g} s ({c.reason})", file=sys.stderr)
+    return 0
+
+
+def add_scene_args(p: argparse.ArgumentParser) -> None:
+    from .mjcf import REPRESENTATIONS
+    from .discretize import ORIENTATIONS
+    from .scene import DEFAULT_SEGMENTS, INTEGRATORS
+    p.add_argument("name", help="catalog id (see `mjeap list`)")
+    p.add_argument("--segments", type=int, default=DEFAULT_SEGMENTS, help="number of segments (>= 2)")
+    p.add_argument("--representation", choices=REPRESENTATIONS, default="hinge")
+    p.add_argument("--payload", help="tip payload MASS@POSITION, e.g. 12.6mg@6.27mm")
+    p.add_argument("--orientation", choices=ORIENTATIONS, default="horizontal")
+    p.add_argument("--timestep", type=float, help="timestep in s (default: chosen from the model)")
+    p.add_argument("--integrator", choices=list(INTEGRATORS), default="implicitfast")
+
+
+def build_parser() -> argparse.ArgumentParser:
+    ap = argparse.ArgumentParser(prog="mjeap", description=__doc__)
+    sub = ap.add_subparsers(dest="command", required=True)
+    sub.add_parser("list", help="list the catalog").set_defaults(func=cmd_list)
+    p = sub.add_parser("show", help="parameters, provenance and derived values of an actuator")
+    p.add_argument("name")
+    p.add_argument("--json", action="store_true")
+    p.set_defaults(func=cmd_show)
+    p = sub.add_parser("mjcf", help="write the MJCF model of an actuator")
+    add_scene_args(p)
+    p.add_argument("-o", "--output", help="output file (default: stdout)")
+    p.set_defaults(func=cmd_mjcf)
+    return ap
+
+
+def main(argv: Optional[List[str]] = None) -> int:
+    args = build_parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except MjeapError as e:
+        print(f"mjeap: error: {e}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())
