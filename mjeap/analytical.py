@@ -23,7 +23,7 @@ __all__ = [
     "deflection_shape_tip_force", "elastica_tip_force", "Elastica", "arc_tip_moment",
     "natural_frequencies", "lateral_stiffness", "buckling_load", "arc_curvature",
     "multilayer_section", "SectionLayer", "SectionProperties", "lateral_stiffness_column",
-    "critical_tip_load",
+    "critical_tip_load", "postbuckled_column",
 ]
 
 
@@ -227,3 +227,21 @@ def critical_tip_load(L: float, EI: float, weight_per_length: float = 0.0) -> fl
         return cols[0][0] * cols[1][1] - cols[0][1] * cols[1][0]
 
     return optimize.brentq(det, 0.5 * Pe, 1.5 * Pe, xtol=1e-12 * Pe)
+
+
+def postbuckled_column(load_ratio: float, L: float) -> Tuple[float, float, float]:
+    """Post-buckled equilibrium of a clamped-free column under a dead axial tip load
+    P = load_ratio x P_cr (load_ratio >= 1), exact elastica (Timoshenko & Gere 1961, sec. 2.7):
+    with p = sin(alpha/2), alpha the tip angle, P / P_cr = (2 K(p^2) / pi)^2;
+    lateral tip deflection delta = 2 p L / K, axial tip position x = L (2 E(p^2) / K - 1).
+    Returns (x, delta, alpha) in m, m, rad. scipy's ellipk/ellipe take m = p^2."""
+    from scipy.special import ellipe, ellipk
+    if load_ratio < 1.0:
+        raise ParameterError("load_ratio", load_ratio, "a value >= 1 (below it the column stays straight)")
+    if load_ratio == 1.0:
+        return L, 0.0, 0.0
+    target = 0.5 * np.pi * np.sqrt(load_ratio)
+    m = optimize.brentq(lambda m: ellipk(m) - target, 0.0, 1.0 - 1e-15)
+    K, E = ellipk(m), ellipe(m)
+    p = np.sqrt(m)
+    return L * (2 * E / K - 1), 2 * p * L / K, 2 * np.arcsin(p)

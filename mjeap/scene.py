@@ -47,6 +47,11 @@ DEFAULT_MAX_BEND = 2.0
 DOF_DAMPING_FIELD = "mjeap_dof_damping"
 
 
+def _floor_sig(x: float, digits: int) -> float:
+    e = np.floor(np.log10(x)) - (digits - 1)
+    return float(np.floor(x / 10**e * (1 + 1e-12)) * 10**e)
+
+
 def apply_dof_damping(model: mujoco.MjModel) -> mujoco.MjModel:
     """Apply the per-dof Rayleigh damping stored in a generated model (cable), in place."""
     i = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_NUMERIC, DOF_DAMPING_FIELD)
@@ -172,7 +177,10 @@ class Scene:
                                                  self.integrator, h_max=T1))
         h_acc = T1 / STEPS_PER_PERIOD
         if timestep is None:
-            h = min(h_acc, STABILITY_SAFETY * h_stab)
+            # rounded down to 3 significant figures in SI: a clean number that does not
+            # depend on the internal units (the limit itself is known to ~1e-4)
+            h_si = min(h_acc, STABILITY_SAFETY * h_stab) * u.time
+            h = _floor_sig(h_si, 3) / u.time
             reason = (f"min(T1/{STEPS_PER_PERIOD} = {h_acc * u.time:.3g} s, "
                       f"{STABILITY_SAFETY} x stability limit {h_stab * u.time:.3g} s)")
         else:
