@@ -222,6 +222,13 @@ class Scene:
         self.joint_ids = np.array([mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, n) for n in h.joints])
         self.joint_qpos = m.jnt_qposadr[self.joint_ids]
         self.joint_dof = m.jnt_dofadr[self.joint_ids]
+        # the bending dof of each hinge: the hinge itself, or a ball joint's rotation about
+        # the local z (hinge) axis
+        self.bend_dof = self.joint_dof + (0 if self.representation == "hinge" else 2)
+        self._k0 = m.jnt_stiffness[self.joint_ids].copy()
+        self._k_bend = self.layout.hinge_stiffness / self.units.rotational_stiffness
+        self._d0 = m.dof_damping.copy()
+        self._stiffness_scale = 1.0
         # offset from the tip body's centre of mass to the tip site, body frame
         self._tip_offset = m.site_pos[self.tip_site_id] - m.body_ipos[self.tip_body_id]
 
@@ -240,6 +247,7 @@ class Scene:
         """Reset to rest; ``curvature`` (1/m) starts the beam as a uniform arc of that
         curvature (seed 000 starts each experiment from a measured curvature)."""
         mujoco.mj_resetData(self.model, self.data)
+        self.set_bending_stiffness_scale(1.0)
         if curvature:
             self.set_hinge_angles(np.full(self.layout.segments, curvature * self.layout.ds))
         mujoco.mj_forward(self.model, self.data)
@@ -297,6 +305,49 @@ class Scene:
             torque = torque + np.cross(arm, f)
         d.xfrc_applied[b, :3] = f
         d.xfrc_applied[b, 3:] = torque
+
+    # ------------------------------------------------------------------ drives
+    def set_internal_moments(self, moments) -> None:
+        """Internal bending moment (N m) at every hinge (scalar: the same everywhere), applied
+        as equal and opposite couples on the two links it joins, i.e. a generalised force
+        on the hinge's bending dof. Replaces the previous call's moments."""
+        M = np.broadcast_to(np.asarray(moments, dtype=float), (self.layout.segments,)) / self.units.moment
+        if self._stiffness_scale != 1.0 and self.representation != "hinge":
+            # the cable plugin's stiffness is fixed at init: add the change as a moment
+            M = M - (self._stiffness_scale - 1.0) * self._k_bend * self.hinge_angles()
+        self.data.qfrc_applied[self.bend_dof] = M
+
+    def set_bending_stiffness_scale(self, factor: float) -> None:
+        """Scale every hinge's bending stiffness (and its Rayleigh damping, which keeps the
+        stability limit) by ``factor`` relative to the catalog beam, e.g. for
+        field-stiffened polymers."""
+        f = check_positive("stiffness factor", factor)
+        if f == self._stiffness_scale:
+            return
+        self._stiffness_scale = f
+        if self.representation == "hinge":
+            self.model.jnt_stiffness[self.joint_ids] = self._k0 * f
+        self.model.dof_damping[self.bend_dof] = self._d0[self.bend_dof] * f
+
+    def hinge_rates(self) -> np.ndarray:
+        """Bending angular velocity of every hinge (rad/s)."""
+        return self.data.qvel[self.bend_dof] / self.units.time
+
+    def hinge_stiffness(self) -> np.ndarray:
+        """Current bending stiffness of every hinge (N m / rad)."""
+        return self.layout.hinge_stiffness * self._stiffness_scale
+
+    def gravity_moments(self) -> np.ndarray:
+        """Moment (N m) that gravity exerts on every hinge's bending dof at the current
+        configuration (at rest)."""
+        d = self.data
+        saved = d.qvel.copy()
+        d.qvel[:] = 0
+        mujoco.mj_forward(self.model, d)
+        out = -d.qfrc_bias[self.bend_dof] * self.units.moment
+        d.qvel[:] = saved
+        mujoco.mj_forward(self.model, d)
+        return out
 
     # ------------------------------------------------------------------ stepping
     def step(self, n: int = 1) -> None:

@@ -1,0 +1,126 @@
+"""Drive plugin interface: a voltage goes in, bending moments come out, in lockstep with MuJoCo.
+
+A drive owns its internal state (charge, relaxation, force), is reset with the scene,
+advances by one MuJoCo step from the input voltage (and, where its physics needs it, the
+beam's state) and writes internal bending moments into the beam with
+:meth:`mjeap.Scene.set_internal_moments`. Linear parts are discretised exactly over the
+step (zero-order hold, ``scipy.signal.cont2discrete``), never by forward Euler.
+
+Drives are registered by name with :func:`register_drive`, so a user's own model runs
+with ``mjeap.rollout(..., drive="my-drive")`` without touching the package.
+"""
+from __future__ import annotations
+
+from typing import ClassVar, Dict, Optional, Tuple, Type
+
+import numpy as np
+from scipy import signal
+
+from ..errors import ParameterError, UnknownNameError
+
+DRIVES: Dict[str, Type["Drive"]] = {}
+
+
+def register_drive(cls: Type["Drive"]) -> Type["Drive"]:
+    """Class decorator: make a :class:`Drive` subclass available by its ``name``."""
+    if not getattr(cls, "name", ""):
+        raise ParameterError("Drive.name", getattr(cls, "name", None), "a non-empty string")
+    DRIVES[cls.name] = cls
+    return cls
+
+
+def get_drive_class(name: str) -> Type["Drive"]:
+    try:
+        return DRIVES[name]
+    except KeyError:
+        raise UnknownNameError("drive", str(name), DRIVES) from None
+
+
+def default_drive_name(actuator_id: str) -> str:
+    """The drive whose source document describes this catalog actuator."""
+    for cls in DRIVES.values():
+        if actuator_id in cls.actuators:
+            return cls.name
+    raise UnknownNameError("drive for actuator", actuator_id, DRIVES)
+
+
+def make_drive(name: Optional[str], scene, **params) -> "Drive":
+    """Instantiate the drive ``name`` (default: the actuator's own) for ``scene``."""
+    name = name or default_drive_name(scene.actuator.id)
+    return get_drive_class(name)(scene, **params)
+
+
+class ExactLTI:
+    """A continuous linear system x' = A x + B u, y = C x + D u, stepped exactly for a
+    zero-order-hold input (scipy.signal.cont2discrete); vectorised over ``n`` copies."""
+
+    def __init__(self, A, B, C, D, dt: float, n: int = 1):
+        Ad, Bd, Cd, Dd, _ = signal.cont2discrete((np.atleast_2d(A), np.atleast_2d(B).reshape(-1, 1),
+                                                  np.atleast_2d(C), np.atleast_2d(D)), dt, method="zoh")
+        self.Ad, self.Bd, self.Cd, self.Dd = Ad, Bd[:, 0], Cd, Dd[:, 0]
+        self.x = np.zeros((n, Ad.shape[0]))
+
+    def output(self, u) -> np.ndarray:
+        return self.x @ self.Cd.T[:, 0] + self.Dd[0] * np.asarray(u)
+
+    def advance(self, u) -> None:
+        self.x = self.x @ self.Ad.T + np.multiply.outer(np.asarray(u, dtype=float), self.Bd).reshape(self.x.shape)
+
+
+class Drive:
+    """Base class. Subclasses set ``name``, ``actuators`` (catalog ids the source
+    describes), ``PARAMETERS`` (per actuator: defaults with their sources) and implement
+    :meth:`reset` and :meth:`step`."""
+
+    name: ClassVar[str] = ""
+    actuators: ClassVar[Tuple[str, ...]] = ()
+    PARAMETERS: ClassVar[Dict[str, Dict[str, Tuple[float, str, str]]]] = {}
+    model_used: str = ""
+
+    def __init__(self, scene, **params):
+        self.scene = scene
+        defaults = self.PARAMETERS.get(scene.actuator.id, {})
+        self.params = {k: v[0] for k, v in defaults.items()}
+        self.sources = {k: f"{v[1]}; {v[2]}" for k, v in defaults.items()}
+        for k, v in params.items():
+            if defaults and k not in defaults and k not in self.extra_parameters():
+                raise ParameterError(f"{self.name} parameter", k, f"one of {', '.join(sorted(defaults))}")
+            self.params[k] = v
+            self.sources[k] = "given by the user"
+
+    def extra_parameters(self) -> Tuple[str, ...]:
+        return ()
+
+    # -- to implement ------------------------------------------------------------------
+    def reset(self, initial_curvature: float = 0.0) -> None:
+        """Reset the drive state; the scene is already reset (and bent, if asked)."""
+
+    def step(self, voltage: float, dt: float) -> None:
+        """Advance one MuJoCo step of ``dt`` s with input ``voltage`` (V) held, writing the
+        bending moments into the scene for this step."""
+        raise NotImplementedError
+
+    def signals(self) -> Dict[str, float]:
+        """Drive quantities to record now, SI, keyed 'name (unit)'."""
+        return {}
+
+    def reference_curvature(self, t: np.ndarray, v: np.ndarray, initial_curvature: float = 0.0
+                            ) -> Optional[np.ndarray]:
+        """Analytical tip curvature (1/m) for this input, if the source has one."""
+        return None
+
+    def voltage_range(self) -> Tuple[float, float]:
+        return tuple(self.scene.actuator.voltage_range)
+
+    def check_voltage(self, v: np.ndarray) -> None:
+        lo, hi = self.voltage_range()
+        v = np.asarray(v)
+        if not np.all(np.isfinite(v)):
+            raise ParameterError("voltage", "NaN", "finite values")
+        if v.min() < lo - 1e-12 or v.max() > hi + 1e-12:
+            raise ParameterError("voltage", f"[{v.min():.4g}, {v.max():.4g}] V",
+                                 f"values in the safe range [{lo:g}, {hi:g}] V of {self.scene.actuator.id} "
+                                 f"under {self.name}")
+
+    def describe(self) -> str:
+        return f"{self.name} ({self.model_used})" if self.model_used else self.name

@@ -1,0 +1,97 @@
+"""Ionic actuator: RC charging and back-relaxation (Dadras 2021, seed 000, eqs. 1-8).
+
+Identified whole-actuator model (eq. 8), K curvature (1/m), V volts:
+
+    K(s)/V(s) = gain (s + zero) / ((s + p_mech)(s + p_elec))
+
+split, as in the paper's block diagram, into
+* electrical: the double-layer voltage v_c = q / C charges through R,
+  v_c / V = p_elec / (s + p_elec), p_elec = 1/(RC);
+* electromechanical: a moment M = Gamma v_c at every hinge (uniform curvature), with
+  Gamma = gain EI / p_elec so that the product has the identified gain;
+* mechanical: (1/EI)(s + zero)/(s + p_mech) from curvature to moment, realised inside the
+  beam as a standard linear solid: each hinge carries an internal variable r,
+  r' = -zero r + (zero - p_mech) theta, and the moment k r. It relaxes *every* moment the
+  beam carries (drive, payload, gravity), which is the feedback inside the mechanical
+  block of the paper. Instantaneous stiffness EI, relaxed stiffness EI p_mech / zero.
+"""
+from __future__ import annotations
+
+from typing import Dict
+
+import numpy as np
+from scipy import signal
+
+from .base import Drive, ExactLTI, register_drive
+
+_SRC = "Dadras et al. 2021 (seed 000), eq. 8 (identified from a 3 V step)"
+
+
+@register_drive
+class RCRelaxationDrive(Drive):
+    name = "rc-relaxation"
+    actuators = ("pedot-micro",)
+    model_used = "lumped RC + standard-linear-solid back-relaxation"
+    PARAMETERS = {"pedot-micro": {
+        "gain": (63.0, "1/(m s)", _SRC),
+        "zero": (0.52, "1/s", _SRC + "; mechanical zero"),
+        "pole_mechanical": (0.3, "1/s", _SRC + "; mechanical pole"),
+        "pole_electrical": (1.8, "1/s", _SRC + "; electrical pole 1/RC"),
+        "capacitance": (1e-3, "F", "assumed (not in the source); only scales the reported charge and current"),
+    }}
+
+    def __init__(self, scene, **params):
+        super().__init__(scene, **params)
+        p = self.params
+        self.EI = float(scene.actuator.flexural_rigidity_at(0.0)[0])
+        self.gamma = p["gain"] * self.EI / p["pole_electrical"]   # N m per volt of v_c
+        dt = scene.timestep
+        a = p["pole_electrical"]
+        self.elec = ExactLTI([[-a]], [a], [[1.0]], [0.0], dt)
+        z, pm = p["zero"], p["pole_mechanical"]
+        self.relax = ExactLTI([[-z]], [z - pm], [[1.0]], [0.0], dt, n=scene.layout.segments)
+        self._v = 0.0
+
+    def reset(self, initial_curvature: float = 0.0) -> None:
+        """Start at rest at the scene's current shape: the relaxation state holds it (zero
+        elastic moment beyond what gravity needs), so a bent start decays on the mechanical
+        pole alone, as the zero-input term of seed 000's eq. (7)."""
+        sc = self.scene
+        theta = sc.hinge_angles()
+        # equilibrium at rest: k (theta - r) = gravity moment on each hinge
+        self.relax.x[:, 0] = theta - sc.gravity_moments() / sc.hinge_stiffness()
+        self.elec.x[:] = 0.0
+        self._v = 0.0
+        self._apply()
+
+    def _apply(self):
+        sc = self.scene
+        self._m_drive = self.gamma * self.elec.x[0, 0]
+        self._m_relax = sc.hinge_stiffness() * self.relax.x[:, 0]
+        sc.set_internal_moments(self._m_drive + self._m_relax)
+
+    def step(self, voltage: float, dt: float) -> None:
+        self._v = voltage
+        self._apply()
+        self.elec.advance(voltage)
+        self.relax.advance(self.scene.hinge_angles())
+
+    def signals(self) -> Dict[str, float]:
+        C = self.params["capacitance"]
+        vc = float(self.elec.x[0, 0])
+        return {"double_layer_voltage (V)": vc, "charge (C)": C * vc,
+                "current (A)": C * self.params["pole_electrical"] * (self._v - vc),
+                "drive_moment (N m)": float(self._m_drive),
+                "relaxation_moment_mean (N m)": float(np.mean(self._m_relax))}
+
+    def transfer_function(self) -> signal.TransferFunction:
+        """Eq. (8): K(s)/V(s) in 1/(m V)."""
+        p = self.params
+        return signal.TransferFunction(p["gain"] * np.array([1.0, p["zero"]]),
+                                       np.polymul([1.0, p["pole_mechanical"]], [1.0, p["pole_electrical"]]))
+
+    def reference_curvature(self, t, v, initial_curvature=0.0):
+        """Eq. (8) by scipy.signal.lsim from rest, plus the initial curvature decaying on the
+        mechanical pole (the zero-input term of eq. 7). Unloaded beam."""
+        _, y, _ = signal.lsim(self.transfer_function(), np.asarray(v, dtype=float), np.asarray(t, dtype=float))
+        return y + initial_curvature * np.exp(-self.params["pole_mechanical"] * (np.asarray(t) - t[0]))
