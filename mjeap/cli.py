@@ -121,6 +121,30 @@ def cmd_mjcf(args) -> int:
     return 0
 
 
+def cmd_rollout(args) -> int:
+    from .rollout import rollout
+    scene = _scene_from_args(args)
+    params = {}
+    for kv in args.param or []:
+        k, _, v = kv.partition("=")
+        try:
+            params[k] = json.loads(v)
+        except json.JSONDecodeError:
+            params[k] = v
+    r = rollout(scene, args.voltage, args.duration, drive=args.drive, drive_params=params,
+                initial_curvature=args.initial_curvature, rrd=args.rrd, csv_path=args.csv,
+                progress=None if not args.quiet else False)
+    summary = {"actuator": scene.actuator.id, "drive": r.meta["drive"], "voltage": args.voltage,
+               "duration_s": args.duration, "timestep_s": scene.timestep, "steps": r.meta["steps"],
+               "wall_time_s": round(r.meta["wall_time_s"], 3),
+               "tip_curvature_final_per_m": float(r.tip_curvature[-1]),
+               "tip_curvature_peak_to_peak_per_m": r.peak_to_peak(),
+               "tip_deflection_final_m": float(r.tip_position[-1, 1]),
+               "rrd": args.rrd, "csv": args.csv}
+    print(json.dumps(summary, indent=2))
+    return 0
+
+
 def add_scene_args(p: argparse.ArgumentParser) -> None:
     from .mjcf import REPRESENTATIONS
     from .discretize import ORIENTATIONS
@@ -146,6 +170,18 @@ def build_parser() -> argparse.ArgumentParser:
     add_scene_args(p)
     p.add_argument("-o", "--output", help="output file (default: stdout)")
     p.set_defaults(func=cmd_mjcf)
+    p = sub.add_parser("rollout", help="run an actuator with its drive and record it")
+    add_scene_args(p)
+    p.add_argument("--voltage", required=True,
+                   help="waveform, e.g. step:3V, square:1.5V@0.1Hz, sine:50V@100Hz,offset=100V, csv:FILE")
+    p.add_argument("--duration", type=float, required=True, help="simulated time (s)")
+    p.add_argument("--drive", help="drive name (default: the actuator's own)")
+    p.add_argument("--param", action="append", metavar="KEY=VALUE", help="drive parameter (repeatable)")
+    p.add_argument("--initial-curvature", type=float, default=0.0, help="start as a uniform arc (1/m)")
+    p.add_argument("--rrd", help="write a Rerun recording here")
+    p.add_argument("--csv", help="write the time series here")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_rollout)
     return ap
 
 

@@ -1,0 +1,87 @@
+"""Blocking-force drive for the PPy trilayer (Mutlu, Alici, Li 2013, seed 001).
+
+The measured blocking force F_B(t, V) becomes a uniform internal moment
+M = (2/3) F_B L at every joint (the moment whose free beam, held at the tip, pushes with
+F_B = 3 M / (2 L)). F_B follows a first-order response to the voltage,
+F_B / V = F_1 / (tau s + 1), stepped exactly. Joint stiffness (and with it damping) may
+depend on the voltage through a table of (volts, factor) pairs, as the paper identifies
+stiffness and damping per voltage (its Fig. 3).
+"""
+from __future__ import annotations
+
+from typing import Dict, Sequence, Tuple
+
+import numpy as np
+from scipy import signal
+
+from ..errors import ParameterError
+from .base import Drive, ExactLTI, register_drive
+
+_EST = "estimate (seed 001 gives no extractable number; actuator reference: a few tenths of a mN to ~1 mN at 1 V)"
+
+
+class VoltageTable:
+    """Piecewise-linear factor of |V| from (volts, factor) pairs; 1 when empty."""
+
+    def __init__(self, pairs: Sequence[Tuple[float, float]] = (), name: str = "table"):
+        pairs = sorted((float(v), float(f)) for v, f in pairs)
+        if any(f <= 0 for _, f in pairs):
+            raise ParameterError(name, pairs, "positive factors")
+        self.v = np.array([p[0] for p in pairs])
+        self.f = np.array([p[1] for p in pairs])
+
+    def __call__(self, voltage: float) -> float:
+        if self.v.size == 0:
+            return 1.0
+        return float(np.interp(abs(voltage), self.v, self.f))
+
+
+@register_drive
+class BlockingForceDrive(Drive):
+    name = "blocking-force"
+    actuators = ("ppy-trilayer",)
+    model_used = "uniform moment (2/3) F_B L from a first-order blocking force"
+    PARAMETERS = {"ppy-trilayer": {
+        "blocking_force_per_volt": (0.5e-3, "N/V", _EST),
+        "time_constant": (2.0, "s", "estimate (PPy trilayers of this size settle in seconds; not extractable from seed 001)"),
+    }}
+
+    def extra_parameters(self):
+        return ("stiffness_table",)
+
+    def __init__(self, scene, **params):
+        super().__init__(scene, **params)
+        self.params.setdefault("blocking_force_per_volt", 0.5e-3)
+        self.params.setdefault("time_constant", 2.0)
+        self.stiffness = VoltageTable(self.params.get("stiffness_table", ()), "stiffness_table")
+        tau = float(self.params["time_constant"])
+        if tau <= 0:
+            raise ParameterError("time_constant", tau, "a positive time in s")
+        F1 = float(self.params["blocking_force_per_volt"])
+        self.force = ExactLTI([[-1 / tau]], [F1 / tau], [[1.0]], [0.0], scene.timestep)
+        self.L = scene.layout.length
+
+    def reset(self, initial_curvature: float = 0.0) -> None:
+        self.force.x[:] = 0.0
+        self.scene.set_bending_stiffness_scale(1.0)
+        self._moment = 0.0
+        self.scene.set_internal_moments(0.0)
+
+    def step(self, voltage: float, dt: float) -> None:
+        self.scene.set_bending_stiffness_scale(self.stiffness(voltage))
+        self._moment = 2.0 / 3.0 * self.force.x[0, 0] * self.L
+        self.scene.set_internal_moments(self._moment)
+        self.force.advance(voltage)
+
+    def signals(self) -> Dict[str, float]:
+        return {"blocking_force (N)": float(self.force.x[0, 0]), "drive_moment (N m)": float(self._moment),
+                "stiffness_factor (-)": float(self.scene._stiffness_scale)}
+
+    def reference_curvature(self, t, v, initial_curvature=0.0):
+        """Quasi-static: uniform curvature (2/3) F_B L / (f(V) EI), F_B by scipy lsim
+        of the same first-order response (beam inertia and damping neglected)."""
+        tau, F1 = self.params["time_constant"], self.params["blocking_force_per_volt"]
+        _, FB, _ = signal.lsim(signal.TransferFunction([F1], [tau, 1.0]), np.asarray(v, float), np.asarray(t, float))
+        EI = float(self.scene.actuator.flexural_rigidity_at(0.0)[0])
+        f = np.array([self.stiffness(x) for x in v])
+        return 2.0 / 3.0 * FB * self.L / (f * EI)

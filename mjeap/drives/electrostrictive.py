@@ -1,0 +1,115 @@
+"""Electrostrictive terpolymer unimorph (Metello 2020, seed 002).
+
+Two models, chosen with ``model=``:
+
+* ``maxwell`` (thesis eqs. 3.7-3.11, as the thesis evaluates them in Table 3.8):
+  strain S_m = eps0 eps_r E^2 / Y, stress sigma = Y S_m, axial force F_x = sigma L t_a,
+  moment M = sigma I / z_c with I = w h^3 / 12 of the whole stack, tip force F_y = M / L.
+  The textbook Maxwell stress is eps0 eps_r E^2 / 2; the thesis's Table 3.8 numbers
+  (S_m = 0.0545 % at 11.67 MV/m) need the form without the 1/2, which is reproduced here.
+  In the beam, M acts as a uniform internal moment.
+* ``eigenstrain``: the active layer's free in-plane strain S_m (same magnitude) turned into
+  a bending moment by the layer stack, M = E_a w_a S_m [(z_1 - z_c)^2 - (z_0 - z_c)^2] / 2.
+
+E = V / t_active; the response is even in V (electrostriction). With ``stiffening=True``
+the hinge stiffness follows the measured load-displacement slopes (Tables 4.1-4.4)
+relative to 0 V, linearly interpolated in |E|.
+"""
+from __future__ import annotations
+
+from typing import Dict
+
+import numpy as np
+
+from ..errors import ParameterError
+from .base import Drive, register_drive
+
+EPS0 = 8.8541878128e-12
+_T = "Metello 2020 (seed 002)"
+#: measured tip stiffness (N/mm) at 0, 8.33, 11.67, 15 MV/m, Tables 4.1-4.4
+SLOPES = {"pvdf-60": (4.70e-4, 1.01e-3, 1.19e-3, 1.16e-3),
+          "pvdf-60-half": (2.80e-4, 5.70e-4, 6.00e-4, 6.20e-4),
+          "pvdf-130": (6.00e-4, 3.57e-3, 4.53e-3, 4.92e-3)}
+FIELDS = np.array([0.0, 8.33e6, 11.67e6, 15e6])
+
+
+def maxwell_stress_model(actuator, voltage: float, relative_permittivity: float = 45.0) -> Dict[str, float]:
+    """The thesis's Maxwell-stress chain (eqs. 3.7-3.11) for a catalog unimorph, SI."""
+    act = actuator
+    active = next(l for l in act.layers if l.name == "terpolymer")
+    E = voltage / active.thickness
+    S = EPS0 * relative_permittivity * E**2 / active.youngs_modulus
+    sigma = active.youngs_modulus * S
+    sec = act.section_at(0.0)
+    I = sec.width * sec.thickness**3 / 12
+    M = sigma * I / sec.neutral_axis
+    return {"field": E, "strain": S, "stress": sigma, "axial_force": sigma * act.length * active.thickness,
+            "moment": M, "tip_force": M / act.length,
+            "tip_deflection_thesis": (M / act.length) * act.length**3 / (3 * sec.flexural_rigidity)}
+
+
+def eigenstrain_moment(actuator, strain: float) -> float:
+    """Moment (N m) of a free in-plane strain of the active layer, multilayer beam."""
+    sec = actuator.section_at(0.0)
+    i = next(k for k, l in enumerate(actuator.layers) if l.name == "terpolymer")
+    lay = actuator.layers[i]
+    z0, z1 = sec.interfaces[i], sec.interfaces[i + 1]
+    E = lay.youngs_modulus / (1 - lay.poisson_ratio**2) if sec.plane_strain else lay.youngs_modulus
+    w = lay.width if lay.width is not None else float(actuator.width_at(0.0))
+    return E * w * strain * ((z1 - sec.neutral_axis) ** 2 - (z0 - sec.neutral_axis) ** 2) / 2
+
+
+@register_drive
+class ElectrostrictiveDrive(Drive):
+    name = "electrostrictive"
+    actuators = ("pvdf-60", "pvdf-60-half", "pvdf-130")
+    PARAMETERS = {a: {"relative_permittivity": (45.0, "-", f"{_T}, Table 3.3"),
+                      "model": ("maxwell", "-", f"{_T}, eqs. 3.7-3.11 (or 'eigenstrain')"),
+                      "stiffening": (True, "-", f"{_T}, Tables 4.1-4.4 (measured slopes vs field)")}
+                  for a in ("pvdf-60", "pvdf-60-half", "pvdf-130")}
+
+    def __init__(self, scene, **params):
+        super().__init__(scene, **params)
+        self.params.setdefault("relative_permittivity", 45.0)
+        self.params.setdefault("model", "maxwell")
+        self.params.setdefault("stiffening", False)
+        if self.params["model"] not in ("maxwell", "eigenstrain"):
+            raise ParameterError("model", self.params["model"], "'maxwell' or 'eigenstrain'")
+        self.model_used = {"maxwell": "thesis Maxwell-stress model, eqs. 3.7-3.11",
+                           "eigenstrain": "multilayer eigenstrain model"}[self.params["model"]]
+        act = scene.actuator
+        self.t_active = next(l for l in act.layers if l.name == "terpolymer").thickness
+        slopes = SLOPES.get(act.id)
+        self.factors = None if (slopes is None or not self.params["stiffening"]) else np.array(slopes) / slopes[0]
+        self._E = self._M = 0.0
+
+    def moment(self, voltage: float) -> float:
+        act = self.scene.actuator
+        mx = maxwell_stress_model(act, voltage, self.params["relative_permittivity"])
+        return mx["moment"] if self.params["model"] == "maxwell" else eigenstrain_moment(act, mx["strain"])
+
+    def stiffness_factor(self, field: float) -> float:
+        return 1.0 if self.factors is None else float(np.interp(abs(field), FIELDS, self.factors))
+
+    def reset(self, initial_curvature: float = 0.0) -> None:
+        self.scene.set_bending_stiffness_scale(1.0)
+        self.scene.set_internal_moments(0.0)
+        self._v_last = None
+
+    def step(self, voltage: float, dt: float) -> None:
+        if voltage != self._v_last:  # the drive is static in V: recompute only on change
+            self._E = voltage / self.t_active
+            self._M = self.moment(voltage)
+            self._f = self.stiffness_factor(self._E)
+            self._v_last = voltage
+        self.scene.set_bending_stiffness_scale(self._f)
+        self.scene.set_internal_moments(self._M)
+
+    def signals(self) -> Dict[str, float]:
+        return {"field (V/m)": float(self._E), "drive_moment (N m)": float(self._M),
+                "stiffness_factor (-)": float(self.scene._stiffness_scale)}
+
+    def reference_curvature(self, t, v, initial_curvature=0.0):
+        """Quasi-static uniform curvature M(V) / (f(E) EI) of the continuum beam."""
+        EI = float(self.scene.actuator.flexural_rigidity_at(0.0)[0])
+        return np.array([self.moment(x) / (self.stiffness_factor(x / self.t_active) * EI) for x in v])

@@ -1,0 +1,111 @@
+"""PZT-5H bending bimorph under unipolar simultaneous drive (Jayaram 2018, seed 003).
+
+A constant bias V_bias sits across the outer electrodes and the drive signal
+V_sig in [0, V_bias] on the centre layer, so the two plates see V_sig and V_bias - V_sig
+and the bending follows V_eff = V_sig - V_bias / 2. Moment (Wood et al. 2005,
+Jafferis et al. 2015): at a section of width w,
+
+    M = (1/2) f31 w (t_p + t_cf) V_eff,
+
+so the curvature M / (D w) is uniform even on the trapezoidal planform; with a rigid tip
+extension l_ext the free deflection is (1/4)(1 + 2 l_ext/L) f31 V (t_p + t_cf) L^2 / D.
+
+Actuator current, eq. (1): I = (2 V_sig - V_bias) / (2 R) + C dV_sig/dt + I_mech. The
+motional current is the reciprocal of the moment: I_mech = sum_j Gamma_j dtheta_j/dt with
+Gamma_j = dM_j/dV_sig the transduction coefficient (N m/V) at hinge j, so the
+electromechanical energy balance holds exactly; the seed writes it as K(V_bias) v.
+"""
+from __future__ import annotations
+
+from typing import Dict
+
+import numpy as np
+
+from ..errors import ParameterError
+from .base import Drive, register_drive
+
+_J = "Jafferis et al. 2015: f31 ~ 32 Pa m/V free (24 blocked)"
+_C = ("estimate: seed 003 measures about half the 16 nF datasheet value for a fixed HAMR actuator; "
+      "8 nF scaled with the PZT area (Table 1)")
+_R = "illustrative: the extracted fits of eq. 4a are unreliable (actuator reference); refit before use"
+
+
+def _params(area_mm2: float):
+    return {"bias": (200.0, "V", "seed 003: 25-200 V tested"),
+            "f31": (32.0, "Pa m/V", _J),
+            "capacitance": (8e-9 * area_mm2 / 32.2, "F", _C),
+            "resistance": (1e9, "ohm", _R)}
+
+
+@register_drive
+class PiezoBimorphDrive(Drive):
+    name = "piezo-bimorph"
+    actuators = ("pzt-hamr-large", "pzt-hamr-small", "pzt-robobee")
+    model_used = "unipolar simultaneous drive, Wood/Jafferis effective stress"
+    PARAMETERS = {"pzt-hamr-large": _params(45.5), "pzt-hamr-small": _params(32.2), "pzt-robobee": _params(10.1)}
+
+    def __init__(self, scene, **params):
+        super().__init__(scene, **params)
+        for k, v in _params(32.2).items():
+            self.params.setdefault(k, v[0])
+        if not (0 < self.params["bias"] <= 200.0):
+            raise ParameterError("bias", self.params["bias"], "a value in (0, 200] V (seed 003)")
+        act = scene.actuator
+        names = [l.name for l in act.layers]
+        self.t_p = act.layers[names.index("pzt-top")].thickness
+        self.t_cf = act.layers[names.index("carbon-fibre")].thickness
+        w = scene.layout.hinge_width
+        self.gamma = 0.5 * self.params["f31"] * w * (self.t_p + self.t_cf)   # N m / V per hinge
+        self._v = self._v_prev = 0.5 * self.params["bias"]
+        self._i = np.zeros(3)
+
+    def voltage_range(self):
+        return (0.0, float(self.params["bias"]))
+
+    def reset(self, initial_curvature: float = 0.0) -> None:
+        self._v_prev = None
+        self.scene.set_internal_moments(0.0)
+        self._m = np.zeros(self.scene.layout.segments)
+
+    def step(self, voltage: float, dt: float) -> None:
+        vb = self.params["bias"]
+        self._m = self.gamma * (voltage - 0.5 * vb)
+        self.scene.set_internal_moments(self._m)
+        dv = 0.0 if self._v_prev is None else (voltage - self._v_prev) / dt
+        i_mech = float(self.gamma @ self.scene.hinge_rates())
+        self._i = np.array([(2 * voltage - vb) / (2 * self.params["resistance"]),
+                            self.params["capacitance"] * dv, i_mech])
+        self._v_prev = voltage
+
+    def signals(self) -> Dict[str, float]:
+        return {"current (A)": float(self._i.sum()), "current_resistive (A)": float(self._i[0]),
+                "current_capacitive (A)": float(self._i[1]), "current_motional (A)": float(self._i[2]),
+                "drive_moment_root (N m)": float(self._m[0])}
+
+    # ---- Wood / Jafferis formulas -------------------------------------------------
+    def bending_stiffness_per_width(self) -> float:
+        sec = self.scene.actuator.section_at(0.0)
+        return sec.flexural_rigidity / float(self.scene.actuator.width_at(0.0))
+
+    def free_deflection(self, v_eff: float) -> float:
+        """(1/4)(1 + 2 l_r) f31 V (t_p + t_cf) L^2 / D (m)."""
+        act = self.scene.actuator
+        L = act.length
+        lr = act.planform.extension_length / L
+        return 0.25 * (1 + 2 * lr) * self.params["f31"] * v_eff * (self.t_p + self.t_cf) * L**2 / \
+            self.bending_stiffness_per_width()
+
+    def blocked_force(self, v_eff: float) -> float:
+        """(3/4)(w_n/L) f31 (t_p + t_cf) V G_F with w_n the base width and the taper factor
+        G_F = (L^3 / (3 w_n)) / int_0^L (L - x)^2 / w(x) dx (ratio of the tip compliances
+        of a rectangular and the trapezoidal plate, evaluated with scipy quad)."""
+        from scipy.integrate import quad
+        act = self.scene.actuator
+        L, wn = act.length, act.planform.base_width
+        GF = (L**3 / (3 * wn)) / quad(lambda x: (L - x) ** 2 / float(act.width_at(x)), 0, L)[0]
+        return 0.75 * wn / L * self.params["f31"] * (self.t_p + self.t_cf) * v_eff * GF
+
+    def reference_curvature(self, t, v, initial_curvature=0.0):
+        """Quasi-static uniform curvature of the free bimorph, M / (D w)."""
+        return 0.5 * self.params["f31"] * (self.t_p + self.t_cf) * (np.asarray(v) - 0.5 * self.params["bias"]) / \
+            self.bending_stiffness_per_width()
