@@ -47,6 +47,14 @@ DEFAULT_MAX_BEND = 2.0
 DOF_DAMPING_FIELD = "mjeap_dof_damping"
 
 
+def _as_slice(idx: np.ndarray):
+    """A slice equal to an evenly spaced index array (else the array itself)."""
+    idx = np.asarray(idx)
+    if len(idx) > 1 and np.all(np.diff(idx) == idx[1] - idx[0]) and idx[1] > idx[0]:
+        return slice(int(idx[0]), int(idx[-1]) + 1, int(idx[1] - idx[0]))
+    return idx
+
+
 def _floor_sig(x: float, digits: int) -> float:
     e = np.floor(np.log10(x)) - (digits - 1)
     return float(np.floor(x / 10**e * (1 + 1e-12)) * 10**e)
@@ -225,6 +233,10 @@ class Scene:
         # the bending dof of each hinge: the hinge itself, or a ball joint's rotation about
         # the local z (hinge) axis
         self.bend_dof = self.joint_dof + (0 if self.representation == "hinge" else 2)
+        # the same as slices (views, no copies) when evenly spaced, for the per-step paths
+        self._bend_sl = _as_slice(self.bend_dof)
+        self._qpos_sl = _as_slice(self.joint_qpos) if self.representation == "hinge" else None
+        self._inv_moment = 1.0 / self.units.moment
         self._k0 = m.jnt_stiffness[self.joint_ids].copy()
         self._k_bend = self.layout.hinge_stiffness / self.units.rotational_stiffness
         self._d0 = m.dof_damping.copy()
@@ -269,8 +281,8 @@ class Scene:
     def hinge_angles(self) -> np.ndarray:
         """Bending angle (rad) of every hinge about the hinge axis."""
         q = self.data.qpos
-        if self.representation == "hinge":
-            return q[self.joint_qpos].copy()
+        if self._qpos_sl is not None:
+            return q[self._qpos_sl].copy()
         out = np.empty(len(self.joint_qpos))
         for i, adr in enumerate(self.joint_qpos):
             w, _, _, z = q[adr:adr + 4]
@@ -311,11 +323,11 @@ class Scene:
         """Internal bending moment (N m) at every hinge (scalar: the same everywhere), applied
         as equal and opposite couples on the two links it joins, i.e. a generalised force
         on the hinge's bending dof. Replaces the previous call's moments."""
-        M = np.broadcast_to(np.asarray(moments, dtype=float), (self.layout.segments,)) / self.units.moment
+        M = np.multiply(moments, self._inv_moment)
         if self._stiffness_scale != 1.0 and self.representation != "hinge":
             # the cable plugin's stiffness is fixed at init: add the change as a moment
             M = M - (self._stiffness_scale - 1.0) * self._k_bend * self.hinge_angles()
-        self.data.qfrc_applied[self.bend_dof] = M
+        self.data.qfrc_applied[self._bend_sl] = M
 
     def set_bending_stiffness_scale(self, factor: float) -> None:
         """Scale every hinge's bending stiffness (and its Rayleigh damping, which keeps the
@@ -331,7 +343,7 @@ class Scene:
 
     def hinge_rates(self) -> np.ndarray:
         """Bending angular velocity of every hinge (rad/s)."""
-        return self.data.qvel[self.bend_dof] / self.units.time
+        return self.data.qvel[self._bend_sl] / self.units.time
 
     def hinge_stiffness(self) -> np.ndarray:
         """Current bending stiffness of every hinge (N m / rad)."""

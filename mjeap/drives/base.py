@@ -59,11 +59,19 @@ class ExactLTI:
                                                   np.atleast_2d(C), np.atleast_2d(D)), dt, method="zoh")
         self.Ad, self.Bd, self.Cd, self.Dd = Ad, Bd[:, 0], Cd, Dd[:, 0]
         self.x = np.zeros((n, Ad.shape[0]))
+        self._first_order = Ad.shape == (1, 1)
+        if self._first_order:  # x+ = a x + b u, elementwise over the copies
+            self._a, self._b = float(Ad[0, 0]), float(Bd[0, 0])
 
     def output(self, u) -> np.ndarray:
         return self.x @ self.Cd.T[:, 0] + self.Dd[0] * np.asarray(u)
 
     def advance(self, u) -> None:
+        if self._first_order:
+            x = self.x[:, 0]
+            x *= self._a
+            x += self._b * np.asarray(u, dtype=float)
+            return
         self.x = self.x @ self.Ad.T + np.multiply.outer(np.asarray(u, dtype=float), self.Bd).reshape(self.x.shape)
 
 

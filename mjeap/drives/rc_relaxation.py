@@ -62,12 +62,13 @@ class RCRelaxationDrive(Drive):
         self.relax.x[:, 0] = theta - sc.gravity_moments() / sc.hinge_stiffness()
         self.elec.x[:] = 0.0
         self._v = 0.0
+        self._k = sc.hinge_stiffness()
         self._apply()
 
     def _apply(self):
         sc = self.scene
         self._m_drive = self.gamma * self.elec.x[0, 0]
-        self._m_relax = sc.hinge_stiffness() * self.relax.x[:, 0]
+        self._m_relax = self._k * self.relax.x[:, 0]
         sc.set_internal_moments(self._m_drive + self._m_relax)
 
     def step(self, voltage: float, dt: float) -> None:
