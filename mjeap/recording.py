@@ -81,15 +81,21 @@ def write_recording(path, result, scene) -> Path:
                 rec.log(ent, rr.SeriesLines(names=label), static=True)
                 rec.send_columns(ent, indexes=[rr.TimeColumn("time", duration=t)],
                                  columns=rr.Scalars.columns(scalars=np.asarray(y, dtype=float)))
-            stride = max(1, n // MAX_FRAMES)
-            for i in range(0, n, stride):
-                rec.set_time("time", duration=float(t[i]))
-                pts = result.centreline[i] @ R.T
-                rec.log("beam/centreline", rr.LineStrips3D([pts], colors=[[50, 115, 205]]))
-                rec.log("beam/tip", rr.Points3D([pts[-1]], radii=[0.01 * L], colors=[[255, 80, 30]]))
-                if result.payload_position is not None:
-                    rec.log("beam/payload", rr.Points3D([R @ result.payload_position[i]],
-                                                        radii=[scene.payload.sphere_radius], colors=[[190, 50, 50]]))
+            # 3D frames, decimated to at most MAX_FRAMES, sent as columns (one batch)
+            idx = np.arange(0, n, max(1, n // MAX_FRAMES))
+            tf = rr.TimeColumn("time", duration=t[idx])
+            pts = result.centreline[idx] @ R.T                       # (f, N + 2, 3)
+            rec.send_columns("beam/centreline", indexes=[tf],
+                             columns=rr.LineStrips3D.columns(strips=list(pts)).partition([1] * len(idx)))
+            rec.log("beam/centreline", rr.LineStrips3D.from_fields(colors=[[50, 115, 205]]), static=True)
+            rec.send_columns("beam/tip", indexes=[tf],
+                             columns=rr.Points3D.columns(positions=pts[:, -1]))
+            rec.log("beam/tip", rr.Points3D.from_fields(radii=[0.01 * L], colors=[[255, 80, 30]]), static=True)
+            if result.payload_position is not None:
+                rec.send_columns("beam/payload", indexes=[tf],
+                                 columns=rr.Points3D.columns(positions=result.payload_position[idx] @ R.T))
+                rec.log("beam/payload", rr.Points3D.from_fields(radii=[scene.payload.sphere_radius],
+                                                                colors=[[190, 50, 50]]), static=True)
         if "error" in result.meta:
             if n:
                 rec.set_time("time", duration=float(t[-1]))
