@@ -55,6 +55,19 @@ def _as_slice(idx: np.ndarray):
     return idx
 
 
+def _write_hinge_angles(qpos: np.ndarray, qposadr: np.ndarray, angles, hinge: bool) -> None:
+    """Write bending angles (rad) about the local z axis into ``qpos``: hinge joints take
+    the angle, ball joints (cable) the quaternion of that rotation."""
+    if hinge:
+        qpos[qposadr] = angles
+    else:
+        half = 0.5 * np.asarray(angles, dtype=float)
+        qpos[qposadr] = np.cos(half)
+        qpos[qposadr + 1] = 0.0
+        qpos[qposadr + 2] = 0.0
+        qpos[qposadr + 3] = np.sin(half)
+
+
 def _floor_sig(x: float, digits: int) -> float:
     e = np.floor(np.log10(x)) - (digits - 1)
     return float(np.floor(x / 10**e * (1 + 1e-12)) * 10**e)
@@ -143,9 +156,6 @@ class Scene:
         self.reset()
 
     # ------------------------------------------------------------------ construction
-    def _joint_stiffness_per_joint(self) -> np.ndarray:
-        return self.layout.hinge_stiffness / self.units.rotational_stiffness
-
     def _choose_timestep_and_damping(self, zeta: float, timestep: Optional[float]) -> TimestepChoice:
         u = self.units
         try:
@@ -169,7 +179,7 @@ class Scene:
         # damping in MJCF, so the cable's per-dof values (bending, in-plane, twist) travel in
         # a custom numeric field that load_mjcf() and the scene apply after compiling.
         dof_damping = beta * np.clip(np.diag(lin.K_elastic), 0.0, None)
-        kj = self._joint_stiffness_per_joint()
+        kj = self.layout.hinge_stiffness / u.rotational_stiffness
         for j, name in enumerate(self.handles.joints):
             self.spec.joint(name).damping = [beta * kj[j], 0, 0]
         if self.representation != "hinge":
@@ -210,13 +220,10 @@ class Scene:
 
     def _uniform_arc_qpos(self, model: mujoco.MjModel, tip_angle: float) -> np.ndarray:
         q = model.qpos0.copy()
-        th = tip_angle / self.layout.segments
-        for j in self.handles.joints:
-            adr = model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j)]
-            if self.representation == "hinge":
-                q[adr] = th
-            else:
-                q[adr:adr + 4] = [np.cos(th / 2), 0, 0, np.sin(th / 2)]
+        adr = np.array([model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j)]
+                        for j in self.handles.joints])
+        _write_hinge_angles(q, adr, np.full(len(adr), tip_angle / self.layout.segments),
+                            self.representation == "hinge")
         return q
 
     def _ids(self):
@@ -237,8 +244,7 @@ class Scene:
         self._bend_sl = _as_slice(self.bend_dof)
         self._qpos_sl = _as_slice(self.joint_qpos) if self.representation == "hinge" else None
         self._inv_moment = 1.0 / self.units.moment
-        self._k0 = m.jnt_stiffness[self.joint_ids].copy()
-        self._k_bend = self.layout.hinge_stiffness / self.units.rotational_stiffness
+        self._k_bend = self.layout.hinge_stiffness / self.units.rotational_stiffness  # internal units
         self._d0 = m.dof_damping.copy()
         self._stiffness_scale = 1.0
         # offset from the tip body's centre of mass to the tip site, body frame
@@ -270,11 +276,7 @@ class Scene:
         a = np.asarray(angles, dtype=float)
         if a.shape != (self.layout.segments,):
             raise ParameterError("angles", a.shape, f"an array of {self.layout.segments} angles")
-        if self.representation == "hinge":
-            self.data.qpos[self.joint_qpos] = a
-        else:
-            for adr, th in zip(self.joint_qpos, a):
-                self.data.qpos[adr:adr + 4] = [np.cos(th / 2), 0, 0, np.sin(th / 2)]
+        _write_hinge_angles(self.data.qpos, self.joint_qpos, a, self.representation == "hinge")
         self.data.qvel[:] = 0
         mujoco.mj_forward(self.model, self.data)
 
@@ -283,11 +285,7 @@ class Scene:
         q = self.data.qpos
         if self._qpos_sl is not None:
             return q[self._qpos_sl].copy()
-        out = np.empty(len(self.joint_qpos))
-        for i, adr in enumerate(self.joint_qpos):
-            w, _, _, z = q[adr:adr + 4]
-            out[i] = 2 * np.arctan2(z, w)
-        return out
+        return 2 * np.arctan2(q[self.joint_qpos + 3], q[self.joint_qpos])
 
     # ------------------------------------------------------------------ loads
     def set_tip_force(self, force: Union[float, Sequence[float]]) -> None:
@@ -338,7 +336,7 @@ class Scene:
             return
         self._stiffness_scale = f
         if self.representation == "hinge":
-            self.model.jnt_stiffness[self.joint_ids] = self._k0 * f
+            self.model.jnt_stiffness[self.joint_ids] = self._k_bend * f
         self.model.dof_damping[self.bend_dof] = self._d0[self.bend_dof] * f
 
     def hinge_rates(self) -> np.ndarray:
