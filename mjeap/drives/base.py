@@ -83,11 +83,13 @@ class Drive:
     name: ClassVar[str] = ""
     actuators: ClassVar[Tuple[str, ...]] = ()
     PARAMETERS: ClassVar[Dict[str, Dict[str, Tuple[float, str, str]]]] = {}
+    #: defaults for an actuator the source does not describe (a user's own), same layout
+    GENERIC_PARAMETERS: ClassVar[Dict[str, Tuple[float, str, str]]] = {}
     model_used: str = ""
 
     def __init__(self, scene, **params):
         self.scene = scene
-        defaults = self.PARAMETERS.get(scene.actuator.id, {})
+        defaults = self.PARAMETERS.get(scene.actuator.id, self.GENERIC_PARAMETERS)
         self.params = {k: v[0] for k, v in defaults.items()}
         self.sources = {k: f"{v[1]}; {v[2]}" for k, v in defaults.items()}
         for k, v in params.items():

@@ -45,14 +45,13 @@ class BlockingForceDrive(Drive):
         "blocking_force_per_volt": (0.5e-3, "N/V", _EST),
         "time_constant": (2.0, "s", "estimate (PPy trilayers of this size settle in seconds; not extractable from seed 001)"),
     }}
+    GENERIC_PARAMETERS = PARAMETERS["ppy-trilayer"]
 
     def extra_parameters(self):
         return ("stiffness_table",)
 
     def __init__(self, scene, **params):
         super().__init__(scene, **params)
-        self.params.setdefault("blocking_force_per_volt", 0.5e-3)
-        self.params.setdefault("time_constant", 2.0)
         self.stiffness = VoltageTable(self.params.get("stiffness_table", ()), "stiffness_table")
         tau = float(self.params["time_constant"])
         if tau <= 0:

@@ -67,12 +67,12 @@ class ElectrostrictiveDrive(Drive):
                       "model": ("maxwell", "-", f"{_T}, eqs. 3.7-3.11 (or 'eigenstrain')"),
                       "stiffening": (True, "-", f"{_T}, Tables 4.1-4.4 (measured slopes vs field)")}
                   for a in ("pvdf-60", "pvdf-60-half", "pvdf-130")}
+    GENERIC_PARAMETERS = {"relative_permittivity": (45.0, "-", f"{_T}, Table 3.3 (terpolymer)"),
+                          "model": ("maxwell", "-", f"{_T}, eqs. 3.7-3.11"),
+                          "stiffening": (False, "-", "no measured slopes for this actuator")}
 
     def __init__(self, scene, **params):
         super().__init__(scene, **params)
-        self.params.setdefault("relative_permittivity", 45.0)
-        self.params.setdefault("model", "maxwell")
-        self.params.setdefault("stiffening", False)
         if self.params["model"] not in ("maxwell", "eigenstrain"):
             raise ParameterError("model", self.params["model"], "'maxwell' or 'eigenstrain'")
         self.model_used = {"maxwell": "thesis Maxwell-stress model, eqs. 3.7-3.11",

@@ -43,11 +43,10 @@ class PiezoBimorphDrive(Drive):
     actuators = ("pzt-hamr-large", "pzt-hamr-small", "pzt-robobee")
     model_used = "unipolar simultaneous drive, Wood/Jafferis effective stress"
     PARAMETERS = {"pzt-hamr-large": _params(45.5), "pzt-hamr-small": _params(32.2), "pzt-robobee": _params(10.1)}
+    GENERIC_PARAMETERS = _params(32.2)
 
     def __init__(self, scene, **params):
         super().__init__(scene, **params)
-        for k, v in _params(32.2).items():
-            self.params.setdefault(k, v[0])
         if not (0 < self.params["bias"] <= 200.0):
             raise ParameterError("bias", self.params["bias"], "a value in (0, 200] V (seed 003)")
         act = scene.actuator
@@ -56,7 +55,7 @@ class PiezoBimorphDrive(Drive):
         self.t_cf = act.layers[names.index("carbon-fibre")].thickness
         w = scene.layout.hinge_width
         self.gamma = 0.5 * self.params["f31"] * w * (self.t_p + self.t_cf)   # N m / V per hinge
-        self._v = self._v_prev = 0.5 * self.params["bias"]
+        self._v_prev = None
         self._i = np.zeros(3)
 
     def voltage_range(self):
