@@ -177,6 +177,14 @@ def lateral_stiffness(L: float, EI: float, axial: float = 0.0) -> float:
     return -axial * a / (np.tan(a * L) - a * L)
 
 
+def _column_rhs(tau_tip: float, kq: float):
+    """Linear column equation in xi = x / L for u = [W, dW, d2W, d3W] (derivatives in xi):
+    d4W = d(tau dW) with tau(xi) = tau_tip + kq (1 - xi), tau = T L^2 / EI (tension > 0)."""
+    def rhs(s, u):
+        return np.array([u[1], u[2], u[3], -kq * u[1] + (tau_tip + kq * (1 - s)) * u[2]])
+    return rhs
+
+
 def lateral_stiffness_column(L: float, EI: float, tip_tension: float, weight_per_length: float = 0.0) -> float:
     """Lateral tip stiffness (N/m) of a cantilever column with axial tension
     T(x) = tip_tension + weight_per_length (L - x) (N; negative = compression).
@@ -189,9 +197,7 @@ def lateral_stiffness_column(L: float, EI: float, tip_tension: float, weight_per
     tau_tip = tip_tension * L**2 / EI
     kq = weight_per_length * L**3 / EI
     xi = np.linspace(0.0, 1.0, 101)
-
-    def rhs(s, u):  # u = [W, W', W'', W''']
-        return np.vstack([u[1], u[2], u[3], -kq * u[1] + (tau_tip + kq * (1 - s)) * u[2]])
+    rhs = _column_rhs(tau_tip, kq)
 
     def bc(u0, u1):
         return np.array([u0[0], u0[1], u1[2], -u1[3] + tau_tip * u1[1] - 1.0])
@@ -216,10 +222,7 @@ def critical_tip_load(L: float, EI: float, weight_per_length: float = 0.0) -> fl
 
     def det(P):
         tau_tip = -P * L**2 / EI
-
-        def rhs(s, u):
-            return [u[1], u[2], u[3], -kq * u[1] + (tau_tip + kq * (1 - s)) * u[2]]
-
+        rhs = _column_rhs(tau_tip, kq)
         cols = []
         for init in ([0, 0, 1, 0], [0, 0, 0, 1]):
             u = integrate.solve_ivp(rhs, (0, 1), init, rtol=1e-11, atol=1e-13).y[:, -1]

@@ -84,9 +84,8 @@ def parse_quantity(text: str, unit: str) -> float:
     for name, factor in ((unit, 1.0), base):
         if suffix.endswith(name) and suffix[: len(suffix) - len(name)] in _PREFIX:
             pre = suffix[: len(suffix) - len(name)]
-            if name == unit and pre:      # no prefix on a base unit that already has one ('kg')
-                if unit == "kg":
-                    continue
+            if name == "kg" and pre:      # 'kg' takes no further prefix
+                continue
             return value * _PREFIX[pre] * factor
     raise ParameterError("quantity", text, f"a number with unit {unit!r} (SI prefixes k, m, u, n allowed)")
 

@@ -14,8 +14,10 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Dict, Optional, Union
 
+import mujoco
 import numpy as np
 
+from .analytical import arc_curvature
 from .errors import DivergenceError, check_positive
 from .scene import Scene
 from .waveforms import Waveform, parse_waveform
@@ -113,7 +115,7 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
         out_v[i] = v_steps[min(step, n_steps - 1)]
         tip[i] = scene.tip_position()
         ang[i] = scene.tip_angle()
-        kap[i] = scene.tip_curvature()
+        kap[i] = arc_curvature(tip[i, 0], tip[i, 1])
         cl[i] = scene.centreline()
         if pay is not None:
             pay[i] = scene.payload_position()
@@ -127,7 +129,6 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     bar = tqdm(total=n_steps, unit="step", desc=f"{scene.actuator.id} {drv.name}", disable=not show,
                leave=False) if tqdm else None
     m, d = scene.model, scene.data
-    import mujoco
     step_fn = mujoco.mj_step
     i_sample, error = 0, None
     wall0 = _time.perf_counter()
