@@ -248,3 +248,103 @@ def postbuckled_column(load_ratio: float, L: float) -> Tuple[float, float, float
     K, E = ellipk(m), ellipe(m)
     p = np.sqrt(m)
     return L * (2 * E / K - 1), 2 * p * L / K, 2 * np.arcsin(p)
+
+
+def critical_load_with_arm(L: float, EI: float, arm: float = 0.0) -> float:
+    """Dead vertical load (N) at which a weightless cantilever standing up buckles when the
+    load sits on a rigid arm of length ``arm`` (m) beyond the tip (payload centre at L + arm).
+    From EI w'' = P (Delta - w), Delta = w(L) + arm w'(L): k arm tan(kL) = 1, k = sqrt(P/EI);
+    pi^2 EI / (4 L^2) for arm = 0."""
+    L, EI = check_positive("L", L, "m"), check_positive("EI", EI, "N m^2")
+    if arm < 0:
+        raise ParameterError("arm", arm, "a length >= 0 m")
+    if arm == 0:
+        return buckling_load(L, EI)
+    kL = optimize.brentq(lambda q: q * (arm / L) * np.sin(q) - np.cos(q), 1e-9, 0.5 * np.pi)
+    return EI * (kL / L) ** 2
+
+
+# ---------------------------------------------------------------- seed 000's loaded-actuator model
+#: Table I of seed 000: region upper bounds of kappa*l_e (rad), feedback and input coefficients
+DADRAS_REGIONS = ((-1.05, 0.24, -0.60), (-0.55, 0.70, -0.14), (0.55, 1.00, 0.0), (1.05, 0.70, 0.14),
+                  (np.inf, 0.24, 0.60))
+
+
+@dataclass(frozen=True)
+class DadrasModel:
+    """Seed 000's lumped model (SI): electrical block (k_tf / g_m) / (s + a) from volts to an
+    equivalent moment (N m), mechanical block g_m (s + z) / (s + p) from moment to curvature
+    (1/m), with g_m = 1/EI = 4.86e7 1/(N m^2); together eq. (8),
+    K/V = 63 (s + 0.52) / ((s + 0.3)(s + 1.8)). A payload closes a positive feedback loop on
+    the mechanical block (Table I)."""
+
+    k_tf: float = 63.0
+    zero: float = 0.52
+    pole: float = 0.3
+    electrical_pole: float = 1.8
+    mechanical_gain: float = 4.86e7
+    gravity: float = 9.81
+
+    def region_coefficients(self, mass: float, l_e: float, region: int) -> Tuple[float, float]:
+        """(feedback f in N m^2, constant input M_l in N m) of Table I's region 1-5."""
+        _, cf, cl = DADRAS_REGIONS[region - 1]
+        W = mass * self.gravity
+        return cf * W * 2 * l_e**2 / 3, cl * W * 2 * l_e / 3
+
+    @staticmethod
+    def region_of(kappa: float, l_e: float) -> int:
+        angle = kappa * l_e
+        return next(i + 1 for i, (hi, _, _) in enumerate(DADRAS_REGIONS) if angle < hi)
+
+    def region3_pole(self, mass: float, l_e: float) -> float:
+        """Closed-loop mechanical pole (1/s) of Region 3 (small angles):
+        s = -(p - g_m f z) / (1 - g_m f); it crosses zero when g_m f z = p."""
+        f, _ = self.region_coefficients(mass, l_e, 3)
+        gf = self.mechanical_gain * f
+        return -(self.pole - gf * self.zero) / (1 - gf)
+
+    def marginal_mass(self, l_e: float) -> float:
+        """Payload mass (kg) at which the Region 3 pole reaches the origin."""
+        return 3 * self.pole / (2 * self.mechanical_gain * self.zero * self.gravity * l_e**2)
+
+    def response(self, t: np.ndarray, v: np.ndarray, mass: float = 0.0, l_e: float = 6e-3,
+                 kappa0: float = 0.0) -> Tuple[np.ndarray, np.ndarray]:
+        """Curvature (1/m) and region number at the sample times ``t`` (s, uniform) for the
+        voltage samples ``v`` (V, held between samples), as the paper describes it: in each
+        region the closed-loop system with that region's feedback and constant mechanical
+        input; on entering a region the curvature carries over (the mechanical state is
+        re-initialised so that kappa is continuous), the electrical state carries over.
+        The initial curvature kappa(0-) sits on the mechanical state (as in eq. (7)).
+        Exact zero-order-hold discretisation per region (scipy.signal.cont2discrete)."""
+        from scipy import signal
+        t, v = np.asarray(t, float), np.asarray(v, float)
+        h = float(t[1] - t[0])
+        gm, z, p, a = self.mechanical_gain, self.zero, self.pole, self.electrical_pole
+        b = self.k_tf / gm
+        cache = {}
+
+        def discrete(region):
+            if region not in cache:
+                f, Ml = self.region_coefficients(mass, l_e, region)
+                c = gm / (1 - gm * f)               # kappa = c (x + u_e + M_l)
+                # states (u_e, x); x' = -p x + (z - p)(u_e + M_l + f kappa); inputs (V, M_l)
+                A = np.array([[-a, 0.0], [(z - p) * (1 + f * c), -p + (z - p) * f * c]])
+                B = np.array([[b, 0.0], [0.0, (z - p) * (1 + f * c)]])
+                Ad, Bd, *_ = signal.cont2discrete((A, B, np.eye(2), np.zeros((2, 2))), h, method="zoh")
+                cache[region] = (Ad, Bd, c, Ml)
+            return cache[region]
+
+        region = self.region_of(kappa0, l_e)
+        Ad, Bd, c, Ml = discrete(region)
+        s = np.array([0.0, kappa0 / c - Ml])
+        kap, reg = np.empty(len(t)), np.empty(len(t), dtype=int)
+        for i in range(len(t)):
+            k = c * (s[0] + s[1] + Ml)
+            new = self.region_of(k, l_e)
+            if new != region:
+                region = new
+                Ad, Bd, c, Ml = discrete(region)
+                s[1] = k / c - s[0] - Ml
+            kap[i], reg[i] = k, region
+            s = Ad @ s + Bd @ np.array([v[i], Ml])
+        return kap, reg

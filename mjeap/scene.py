@@ -339,13 +339,40 @@ class Scene:
             self.model.jnt_stiffness[self.joint_ids] = self._k_bend * f
         self.model.dof_damping[self.bend_dof] = self._d0[self.bend_dof] * f
 
+    def set_hinge_parameters(self, stiffness=None, damping=None) -> None:
+        """Set every hinge's bending stiffness (N m / rad) and/or viscous damping (N m s / rad),
+        scalars or one value per hinge, replacing the catalog beam's (the joint-level view of
+        seed 001's model; see :mod:`mjeap.identify`). Hinge chain only. The timestep is not
+        re-chosen: a stiffer, less damped chain than the scene was built for can diverge
+        (the step then raises :class:`DivergenceError`)."""
+        if self.representation != "hinge":
+            raise ParameterError("representation", self.representation,
+                                 "'hinge' (per-joint stiffness and damping are a hinge-chain notion)")
+        n = self.layout.segments
+        if stiffness is not None:
+            k = np.broadcast_to(np.asarray(stiffness, float), (n,))
+            if not np.all(np.isfinite(k) & (k > 0)):
+                raise ParameterError("stiffness", stiffness, "positive finite values in N m/rad")
+            self._k_bend = k / self.units.rotational_stiffness
+            self.model.jnt_stiffness[self.joint_ids] = self._k_bend * self._stiffness_scale
+        if damping is not None:
+            b = np.broadcast_to(np.asarray(damping, float), (n,))
+            if not np.all(np.isfinite(b) & (b >= 0)):
+                raise ParameterError("damping", damping, "finite values >= 0 in N m s/rad")
+            self._d0[self.bend_dof] = b / self.units.rotational_damping
+            self.model.dof_damping[self.bend_dof] = self._d0[self.bend_dof] * self._stiffness_scale
+
+    def hinge_damping(self) -> np.ndarray:
+        """Current viscous damping of every hinge's bending dof (N m s / rad)."""
+        return self.model.dof_damping[self.bend_dof] * self.units.rotational_damping
+
     def hinge_rates(self) -> np.ndarray:
         """Bending angular velocity of every hinge (rad/s)."""
         return self.data.qvel[self._bend_sl] / self.units.time
 
     def hinge_stiffness(self) -> np.ndarray:
         """Current bending stiffness of every hinge (N m / rad)."""
-        return self.layout.hinge_stiffness * self._stiffness_scale
+        return self._k_bend * self.units.rotational_stiffness * self._stiffness_scale
 
     def gravity_moments(self) -> np.ndarray:
         """Moment (N m) that gravity exerts on every hinge's bending dof at the current

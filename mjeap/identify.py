@@ -1,0 +1,219 @@
+"""System identification the way the source papers do it, on measured or simulated data (SI).
+
+* :func:`fit_step_response` (seed 000, eqs. 7-8): a curvature step response fitted by two
+  exponentials, kappa(t) = A + B exp(-p t) + C exp(-a t); the fast pole a is electrical
+  (1/RC), the slow pole p and a zero z mechanical (back-relaxation), the initial curvature
+  decays on the mechanical pole. Returns the transfer function and a drive that runs it.
+* :func:`fit_hinge_parameters` (seed 001): joint stiffness and damping of the hinge chain
+  fitted to a measured tip trajectory by nonlinear least squares (scipy.optimize), the chain
+  itself (a :class:`~mjeap.scene.Scene`) being the model.
+* :func:`read_columns`: a user's CSV, checked (columns present, time increasing, finite,
+  enough samples) with errors that say what is wrong.
+"""
+from __future__ import annotations
+
+import csv
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Dict, Optional, Sequence, Tuple, Union
+
+import numpy as np
+from scipy import optimize, signal
+
+from .errors import ParameterError
+
+#: fewest samples accepted by the fits
+MIN_SAMPLES = 20
+
+
+# ---------------------------------------------------------------- data
+def check_series(time, *series, names: Sequence[str] = (), min_samples: int = MIN_SAMPLES) -> Tuple[np.ndarray, ...]:
+    """Validate a time base and series of equal length: finite, strictly increasing time,
+    at least ``min_samples`` samples. Returns float arrays."""
+    t = np.asarray(time, dtype=float)
+    names = list(names) or [f"series {i}" for i in range(len(series))]
+    if t.ndim != 1 or len(t) < min_samples:
+        raise ParameterError("time", f"{len(np.atleast_1d(t))} samples", f"at least {min_samples} samples")
+    out = [t]
+    for name, y in zip(names, series):
+        y = np.asarray(y, dtype=float)
+        if y.shape[0] != len(t):
+            raise ParameterError(name, f"{y.shape[0]} samples", f"as many samples as time ({len(t)})")
+        bad = np.flatnonzero(~np.isfinite(y.reshape(len(t), -1)).all(axis=1))
+        if len(bad):
+            raise ParameterError(name, f"NaN or inf at row {bad[0]} (t = {t[bad[0]]:g} s)", "finite numbers")
+        out.append(y)
+    bad = np.flatnonzero(~np.isfinite(t))
+    if len(bad):
+        raise ParameterError("time", f"NaN or inf at row {bad[0]}", "finite numbers")
+    back = np.flatnonzero(np.diff(t) <= 0)
+    if len(back):
+        i = back[0]
+        raise ParameterError("time", f"t[{i + 1}] = {t[i + 1]:g} s after t[{i}] = {t[i]:g} s",
+                             "strictly increasing time")
+    return tuple(out)
+
+
+def read_columns(path: Union[str, Path], columns: Sequence[str], min_samples: int = MIN_SAMPLES) -> Dict[str, np.ndarray]:
+    """Read the named columns of a CSV with a header row. A header matches a requested name
+    when it is equal or starts with it followed by ' (' (a unit), e.g. 'time (s)' for 'time'.
+    The first column requested is the time base and is checked like :func:`check_series`."""
+    path = Path(path)
+    if not path.is_file():
+        raise ParameterError("data file", str(path), "an existing CSV file")
+    with open(path, newline="") as fh:
+        rows = list(csv.reader(fh))
+    if not rows:
+        raise ParameterError("data file", str(path), "a CSV with a header row and data")
+    header = [h.strip() for h in rows[0]]
+    idx = {}
+    for c in columns:
+        hits = [i for i, h in enumerate(header) if h == c or h.startswith(c + " (")]
+        if not hits:
+            raise ParameterError("column", c, f"one of the file's columns: {', '.join(header)}")
+        idx[c] = hits[0]
+    data = {c: np.empty(len(rows) - 1) for c in columns}
+    for r, row in enumerate(rows[1:], start=2):
+        for c, i in idx.items():
+            try:
+                data[c][r - 2] = float(row[i]) if i < len(row) and row[i].strip() else np.nan
+            except ValueError:
+                raise ParameterError(f"column '{c}'", f"'{row[i]}' on line {r}", "numbers") from None
+    t, *rest = check_series(data[columns[0]], *(data[c] for c in columns[1:]), names=columns[1:],
+                            min_samples=min_samples)
+    return {columns[0]: t, **dict(zip(columns[1:], rest))}
+
+
+# ---------------------------------------------------------------- seed 000: step response
+@dataclass(frozen=True)
+class StepFit:
+    """kappa(t) = A + B exp(-p t) + C exp(-a t) after a step of ``voltage`` V at t = 0, and
+    the transfer function K/V = gain (s + zero) / ((s + p)(s + a)) it implies (1/m per V)."""
+
+    A: float
+    B: float
+    C: float
+    pole_mechanical: float       # p, 1/s
+    pole_electrical: float       # a, 1/s
+    voltage: float
+    gain: float
+    zero: float
+    initial_curvature: float     # kappa(0-), 1/m
+    rms_residual: float          # 1/m
+
+    @property
+    def transfer_function(self) -> signal.TransferFunction:
+        return signal.TransferFunction([self.gain, self.gain * self.zero],
+                                       np.polymul([1, self.pole_mechanical], [1, self.pole_electrical]))
+
+    def curve(self, t) -> np.ndarray:
+        t = np.asarray(t, float)
+        return self.A + self.B * np.exp(-self.pole_mechanical * t) + self.C * np.exp(-self.pole_electrical * t)
+
+    def drive_parameters(self) -> Dict[str, float]:
+        """Parameters of the ``rc-relaxation`` drive that runs this model."""
+        return {"gain": self.gain, "zero": self.zero, "pole_mechanical": self.pole_mechanical,
+                "pole_electrical": self.pole_electrical}
+
+    def make_drive(self, scene):
+        from .drives import make_drive
+        return make_drive("rc-relaxation", scene, **self.drive_parameters())
+
+
+def fit_step_response(time, curvature, voltage: float, t_step: float = 0.0) -> StepFit:
+    """Fit a curvature step response (time in s, curvature in 1/m, the step of ``voltage`` V
+    applied at ``t_step``) as seed 000 does (eq. 7) and derive eq. (8)'s form.
+
+    From the step response of gain (s + z)/((s + p)(s + a)) x V/s plus the zero-input term
+    kappa0 exp(-p t): A = g V z/(p a), C = g V (z - a)/(a (a - p)), hence
+    g V = A p - C (a - p), z = A a p/(g V), and kappa0 = A + B + C."""
+    t, k = check_series(time, curvature, names=["curvature"])
+    if not np.isfinite(voltage) or voltage == 0:
+        raise ParameterError("voltage", voltage, "the step's non-zero amplitude in V")
+    sel = t >= t_step
+    if sel.sum() < MIN_SAMPLES:
+        raise ParameterError("t_step", t_step, f"a time leaving at least {MIN_SAMPLES} samples after it")
+    t, k = t[sel] - t_step, k[sel]
+    span = t[-1]
+
+    def model(x, tt):
+        A, B, C, lp, ld = x
+        p = np.exp(lp)
+        return A + B * np.exp(-p * tt) + C * np.exp(-(p + np.exp(ld)) * tt)
+
+    best = None
+    for p0 in (1.0 / span, 3.0 / span, 10.0 / span):
+        for ratio in (3.0, 10.0, 30.0):
+            x0 = [k[-1], 0.5 * (k[0] - k[-1]), 0.5 * (k[0] - k[-1]), np.log(p0), np.log(p0 * (ratio - 1))]
+            res = optimize.least_squares(lambda x: model(x, t) - k, x0, method="lm", max_nfev=4000)
+            if best is None or res.cost < best.cost:
+                best = res
+    A, B, C, lp, ld = best.x
+    p = float(np.exp(lp))
+    a = p + float(np.exp(ld))
+    gV = A * p - C * (a - p)
+    if gV == 0:
+        raise ParameterError("curvature", "a response without a step", "a step response with a visible transient")
+    z = A * a * p / gV
+    rms = float(np.sqrt(np.mean(best.fun ** 2)))
+    return StepFit(float(A), float(B), float(C), p, a, float(voltage), float(gV / voltage), float(z),
+                   float(A + B + C), rms)
+
+
+# ---------------------------------------------------------------- seed 001: joint stiffness and damping
+@dataclass(frozen=True)
+class HingeFit:
+    stiffness: float             # N m / rad, every hinge
+    damping: float               # N m s / rad, every hinge
+    stiffness_std: float         # 1-sigma from the Jacobian (same units)
+    damping_std: float
+    rms_residual: float          # m
+    evaluations: int
+
+
+def simulate_tip(scene, stiffness: float, damping: float, voltage, duration: float, times: np.ndarray,
+                 drive=None, drive_params: Optional[dict] = None) -> np.ndarray:
+    """Tip deflection (m, clamp frame y) of ``scene`` with uniform hinge ``stiffness`` and
+    ``damping`` driven by ``voltage`` for ``duration`` s, interpolated at ``times``."""
+    from .rollout import rollout
+    scene.set_hinge_parameters(stiffness=stiffness, damping=damping)
+    r = rollout(scene, voltage, duration, drive=drive, drive_params=drive_params, progress=False,
+                sample_interval=max(scene.timestep, float(np.min(np.diff(times))) / 2) if len(times) > 1 else None)
+    return np.interp(times, r.time, r.tip_position[:, 1])
+
+
+def fit_hinge_parameters(scene, time, tip_deflection, voltage, drive=None, drive_params: Optional[dict] = None,
+                         initial: Optional[Tuple[float, float]] = None) -> HingeFit:
+    """Fit one stiffness and one damping for every hinge of ``scene`` (a hinge chain) so that
+    its tip deflection under ``voltage`` (waveform) follows the measured ``tip_deflection``
+    (m) at ``time`` (s), by nonlinear least squares (scipy.optimize.least_squares on the
+    logarithms; seed 001 identifies its 16-link chain this way). ``initial`` = (k, b) start,
+    default the scene's own values. The scene's hinges are left at the fitted values."""
+    t, y = check_series(time, tip_deflection, names=["tip_deflection"])
+    if np.ptp(y) == 0:
+        raise ParameterError("tip_deflection", "a constant trajectory", "a trajectory that moves")
+    k0, b0 = initial if initial is not None else (float(np.mean(scene.hinge_stiffness())),
+                                                  float(np.mean(scene.hinge_damping())))
+    if not (k0 > 0 and b0 > 0):
+        raise ParameterError("initial", (k0, b0), "positive stiffness (N m/rad) and damping (N m s/rad)")
+    duration = float(t[-1]) + scene.timestep
+    scale = float(np.ptp(y))
+    n_eval = [0]
+
+    def residual(x):
+        n_eval[0] += 1
+        return (simulate_tip(scene, np.exp(x[0]), np.exp(x[1]), voltage, duration, t, drive, drive_params) - y) / scale
+
+    res = optimize.least_squares(residual, [np.log(k0), np.log(b0)], diff_step=1e-4, x_scale=1.0,
+                                 xtol=1e-10, ftol=1e-10, max_nfev=200)
+    k, b = np.exp(res.x)
+    dof = max(1, len(y) - 2)
+    s2 = 2 * res.cost / dof
+    try:
+        cov = np.linalg.inv(res.jac.T @ res.jac) * s2
+        sk, sb = np.sqrt(np.diag(cov))
+    except np.linalg.LinAlgError:
+        sk = sb = np.inf
+    scene.set_hinge_parameters(stiffness=k, damping=b)
+    return HingeFit(float(k), float(b), float(k * sk), float(b * sb),
+                    float(np.sqrt(s2) * scale), n_eval[0])

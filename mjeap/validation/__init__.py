@@ -1,0 +1,62 @@
+"""``mjeap validate``: every validation experiment, headless, with a table, JSON, a Markdown
+report with figures and one Rerun recording per experiment.
+
+Each experiment module holds the experiments of one source; a check compares the simulator
+with a named, independent reference (closed form, scipy solution of a model, a paper's table).
+"""
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Iterable, List, Optional
+
+from .core import REGISTRY, Check, Curve, Experiment, experiment
+from . import mechanics, dadras2021, mutlu2013, metello2020, jayaram2018  # noqa: F401  (register)
+from . import report
+
+__all__ = ["REGISTRY", "Check", "Curve", "Experiment", "experiment", "run_validation", "report"]
+
+
+def select(names: Optional[Iterable[str]] = None) -> List[str]:
+    from ..errors import UnknownNameError
+    if not names:
+        return list(REGISTRY)
+    out = []
+    for n in names:
+        hits = [k for k in REGISTRY if k == n or k.startswith(n)]
+        if not hits:
+            raise UnknownNameError("experiment", n, list(REGISTRY))
+        out += [h for h in hits if h not in out]
+    return out
+
+
+def run_validation(names: Optional[Iterable[str]] = None, out: Optional[Path] = None, quick: bool = False,
+                   progress: bool = True) -> List[Experiment]:
+    """Run the named experiments (prefixes allowed; all by default) and, with ``out``, write
+    ``validation.json``, ``report.md``, a PNG per experiment (with matplotlib) and a ``.rrd``
+    per experiment there. Files are written after each experiment, so an interrupted run keeps
+    what finished."""
+    names = select(names)
+    try:
+        from tqdm import tqdm
+        bar = tqdm(names, desc="validate", unit="exp", disable=not progress)
+    except ImportError:  # pragma: no cover
+        bar = names
+    done: List[Experiment] = []
+    if out is not None:
+        out = Path(out)
+        out.mkdir(parents=True, exist_ok=True)
+    figures = True
+    for name in bar:
+        if hasattr(bar, "set_postfix_str"):
+            bar.set_postfix_str(name)
+        t0 = time.perf_counter()
+        ex = REGISTRY[name](quick=quick)
+        ex.seconds = time.perf_counter() - t0
+        done.append(ex)
+        if out is not None:
+            figures = report.write_figure(ex, out / f"{ex.name}.png") and figures
+            report.write_recording(ex, out / f"{ex.name}.rrd")
+            report.write_json(done, out / "validation.json")
+            report.write_markdown(done, out / "report.md", figures)
+    return done

@@ -1,0 +1,101 @@
+"""Validation records: a check (simulated value against a named reference), a curve (for the
+report's figures and the recording) and an experiment (checks + curves + notes).
+
+A check with a tolerance passes or fails; a check without one is a comparison that is
+reported with its explanation (for example a published measurement the model is not expected
+to reproduce). References are never computed from the simulator itself.
+"""
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, field
+from typing import Callable, Dict, List, Optional
+
+import numpy as np
+
+
+@dataclass
+class Check:
+    """One row of the validation table. ``error`` is relative ((sim - ref) / |ref|) unless
+    ``error_kind`` is 'absolute' (then in ``unit``); ``tolerance`` is on |error|."""
+
+    quantity: str
+    unit: str
+    simulated: float
+    reference: float
+    source: str                       # the reference, named (closed form, paper table, ...)
+    tolerance: Optional[float] = None
+    error_kind: str = "relative"
+    note: str = ""
+    experiment: str = ""
+
+    @property
+    def error(self) -> float:
+        d = self.simulated - self.reference
+        if self.error_kind == "absolute":
+            return float(d)
+        return float(d / abs(self.reference)) if self.reference != 0 else float("inf")
+
+    @property
+    def verdict(self) -> str:
+        if self.tolerance is None:
+            return "compare"
+        ok = np.isfinite(self.error) and abs(self.error) <= self.tolerance
+        return "pass" if ok else "FAIL"
+
+    def as_dict(self) -> dict:
+        d = asdict(self)
+        d.update(error=self.error, verdict=self.verdict)
+        return d
+
+
+@dataclass
+class Curve:
+    """One curve of a figure panel; ``source`` names where it comes from (legend)."""
+
+    panel: str
+    source: str
+    x: np.ndarray
+    y: np.ndarray
+    xlabel: str
+    ylabel: str
+    style: str = "-"                  # matplotlib format: '-' lines, 'o' markers
+
+    def as_dict(self) -> dict:
+        return {"panel": self.panel, "source": self.source, "xlabel": self.xlabel, "ylabel": self.ylabel,
+                "x": np.asarray(self.x, float).tolist(), "y": np.asarray(self.y, float).tolist()}
+
+
+@dataclass
+class Experiment:
+    name: str                         # short id, e.g. 'dadras2021-payloads'
+    title: str
+    checks: List[Check] = field(default_factory=list)
+    curves: List[Curve] = field(default_factory=list)
+    notes: List[str] = field(default_factory=list)
+    rollouts: list = field(default_factory=list)   # (label, RolloutResult, Scene) for the recording
+    seconds: float = 0.0
+
+    def check(self, quantity, unit, simulated, reference, source, tolerance=None, **kw) -> Check:
+        c = Check(quantity, unit, float(simulated), float(reference), source, tolerance,
+                  experiment=self.name, **kw)
+        self.checks.append(c)
+        return c
+
+    def curve(self, panel, source, x, y, xlabel, ylabel, style="-") -> None:
+        self.curves.append(Curve(panel, source, np.asarray(x, float), np.asarray(y, float), xlabel, ylabel, style))
+
+    @property
+    def passed(self) -> bool:
+        return all(c.verdict != "FAIL" for c in self.checks)
+
+
+#: experiment name -> function(quick: bool) -> Experiment, in report order
+REGISTRY: Dict[str, Callable[..., Experiment]] = {}
+
+
+def experiment(name: str):
+    def deco(fn):
+        REGISTRY[name] = fn
+        fn.experiment_name = name
+        return fn
+    return deco

@@ -1,0 +1,149 @@
+"""Beam mechanics of the simulated chain and cable against closed forms: the elastica, the
+exact arc, natural frequencies with tip mass, column buckling and the multilayer section."""
+from __future__ import annotations
+
+import numpy as np
+
+from .. import analytical as an
+from ..discretize import Payload
+from ..scene import Scene
+from ..section import multilayer_section  # noqa: F401  (documented reference)
+from .core import Experiment, experiment
+
+ACT = "pedot-micro"
+L, EI, M_BEAM = 6e-3, 1 / 4.86e7, 0.695e-6
+G = 9.81
+
+
+def settled(scene, force=0.0, moment=0.0):
+    scene.reset()
+    scene.set_tip_force(force)
+    scene.set_tip_moment(moment)
+    scene.settle(tol=1e-9)
+    return scene.tip_position()
+
+
+def free_vibration_frequency(scene, periods: int = 12) -> float:
+    """Mean spacing of upward zero crossings of the tip deflection after release (Hz)."""
+    scene.reset()
+    scene.set_tip_force(1e-3 * scene.layout.length * an.lateral_stiffness(
+        scene.layout.length, float(scene.actuator.flexural_rigidity_at(0)[0])))
+    scene.settle(tol=1e-10)
+    scene.set_tip_force(0.0)
+    scene.data.time = 0.0
+    n = int(periods / scene.choice.first_frequency / scene.timestep)
+    t, y = np.empty(n), np.empty(n)
+    for i in range(n):
+        scene.step()
+        t[i], y[i] = scene.time, scene.tip_position()[1]
+    up = np.where((y[:-1] < 0) & (y[1:] >= 0))[0]
+    tc = t[up] - y[up] * (t[up + 1] - t[up]) / (y[up + 1] - y[up])
+    return 1.0 / np.mean(np.diff(tc))
+
+
+@experiment("mechanics-elastica")
+def elastica(quick: bool = False) -> Experiment:
+    ex = Experiment("mechanics-elastica", "Tip force and tip couple on the PEDOT beam (20 segments)")
+    loads = [0.05, 0.5, 1.0, 2.0, 3.0]
+    for rep in ("hinge", "cable"):
+        sc = Scene(ACT, representation=rep)
+        ys, refs = [], []
+        for a in loads:
+            P = a * EI / L**2
+            tip = settled(sc, force=P)
+            ref = an.elastica_tip_force(P, L, EI)
+            ys.append(tip[1])
+            refs.append(ref.tip[1])
+            if a in (0.05, 1.0, 3.0):
+                ex.check(f"{rep}: tip deflection, P L^2/EI = {a:g}", "m", tip[1], ref.tip[1],
+                         "elastica (scipy solve_bvp)", tolerance=0.01)
+        ex.curve("tip force", f"mjeap {rep}", loads, np.array(ys) / L, "P L^2 / EI (-)", "tip deflection / L (-)", "o")
+        for kl in (0.3, 2.0):
+            M = kl * EI / L
+            settled(sc, moment=M)
+            ex.check(f"{rep}: tip-couple arc curvature, kappa L = {kl:g}", "1/m", sc.tip_curvature(), kl / L,
+                     "exact arc kappa = M / EI", tolerance=0.005)
+    fine = np.linspace(0.02, 3.0, 25)
+    ex.curve("tip force", "elastica (scipy solve_bvp)", fine,
+             [an.elastica_tip_force(a * EI / L**2, L, EI).tip[1] / L for a in fine],
+             "P L^2 / EI (-)", "tip deflection / L (-)")
+    ex.curve("tip force", "Euler-Bernoulli P L^3 / 3EI", fine, fine / 3, "P L^2 / EI (-)", "tip deflection / L (-)", ":")
+    # convergence of the hinge chain
+    Ns = [4, 8, 16, 32]
+    P = EI / L**2
+    ref = an.elastica_tip_force(P, L, EI).tip[1]
+    errs = [abs(settled(Scene(ACT, segments=N), force=P)[1] - ref) / ref for N in Ns]
+    order = -np.polyfit(np.log(Ns), np.log(errs), 1)[0]
+    ex.check("hinge chain: convergence order of the tip error", "-", order, 2.0,
+             "midpoint rule: second order", tolerance=0.15)
+    ex.curve("convergence", "mjeap hinge chain", Ns, np.array(errs) * 100, "segments N", "tip deflection error (%)", "o-")
+    ex.curve("convergence", "N^-2 through N = 4", Ns, errs[0] * 100 * (Ns[0] / np.array(Ns)) ** 2,
+             "segments N", "tip deflection error (%)", "--")
+    return ex
+
+
+@experiment("mechanics-vibration")
+def vibration(quick: bool = False) -> Experiment:
+    ex = Experiment("mechanics-vibration", "First natural frequency with NdFeB tip masses (free vibration)")
+    masses = [0.0, 3.15e-6, 12.6e-6]
+    for rep in (("hinge",) if quick else ("hinge", "cable")):
+        fs, refs = [], []
+        for m in masses:
+            pay = Payload(m, L) if m else None
+            sc = Scene(ACT, representation=rep, payload=pay, damping_ratio=0.005)
+            ref = an.natural_frequencies(L, EI, M_BEAM / L, tip_mass=m, tip_inertia=pay.inertia if pay else 0.0, n=1)[0]
+            f = free_vibration_frequency(sc)
+            fs.append(f)
+            refs.append(ref)
+            ex.check(f"{rep}: f1 with {m * 1e6:g} mg at the tip", "Hz", f, ref,
+                     "cantilever with tip mass and rotary inertia (Erturk & Inman eq. 3.16)", tolerance=0.02)
+        ex.curve("f1", f"mjeap {rep}", np.array(masses) * 1e6, fs, "tip mass (mg)", "f1 (Hz)", "o")
+    mm = np.linspace(0, 12.6e-6, 30)
+    ex.curve("f1", "characteristic equation", mm * 1e6,
+             [an.natural_frequencies(L, EI, M_BEAM / L, tip_mass=m, tip_inertia=Payload(m, L).inertia if m else 0.0,
+                                     n=1)[0] for m in mm], "tip mass (mg)", "f1 (Hz)")
+    return ex
+
+
+@experiment("mechanics-buckling")
+def buckling(quick: bool = False) -> Experiment:
+    ex = Experiment("mechanics-buckling", "PEDOT beam standing up under a tip payload: buckling and post-buckling")
+    P_cr = an.critical_tip_load(L, EI, M_BEAM * G / L)
+    ex.notes.append(f"P_cr with the beam's own weight (scipy shooting) = {P_cr:.5g} N, "
+                    f"{(P_cr / an.buckling_load(L, EI) - 1) * 100:+.2f} % from the weightless Euler load.")
+    for factor in (0.97, 1.03, 1.10):
+        sc = Scene(ACT, orientation="up", payload=Payload(factor * P_cr / G, L))
+        sc.set_hinge_angles(np.full(sc.layout.segments, 1e-3 / sc.layout.segments))  # small push
+        y0 = abs(sc.tip_position()[1])
+        sc.run(3.0)
+        tip = sc.tip_position()
+        if factor < 1:
+            ex.check(f"{factor:g} P_cr: lateral tip deflection 3 s after a small push", "m", abs(tip[1]), 0.0,
+                     "stable column returns straight (tolerance: 1 % of the push)", tolerance=0.01 * y0,
+                     error_kind="absolute")
+        else:
+            x_ref, d_ref, _ = an.postbuckled_column(factor, L)
+            ex.check(f"{factor:g} P_cr: post-buckled tip deflection", "m", abs(tip[1]), d_ref,
+                     "post-buckled elastica (elliptic integrals)", tolerance=0.03)
+            ex.curve("post-buckling", "mjeap hinge chain", [factor], [abs(tip[1]) / L],
+                     "P / P_cr (-)", "tip deflection / L (-)", "o")
+    ratios = np.linspace(1.0, 1.3, 30)
+    ex.curve("post-buckling", "elastica (Timoshenko & Gere)", ratios,
+             [an.postbuckled_column(r, L)[1] / L for r in ratios], "P / P_cr (-)", "tip deflection / L (-)")
+    return ex
+
+
+@experiment("mechanics-section")
+def section(quick: bool = False) -> Experiment:
+    from ..catalog import PVDF_60
+    ex = Experiment("mechanics-section", "Multilayer cross-section of 60PVDF (thesis eqs. 3.1-3.6)")
+    s = PVDF_60.section_at(0.0)
+    ex.check("neutral axis z_c", "m", s.neutral_axis, 0.132e-3, "Metello 2020 (seed 002), sec. 3.3", tolerance=0.01)
+    ex.check("flexural rigidity EI", "N m^2", s.flexural_rigidity, 2.703e-5, "Metello 2020 (seed 002), sec. 3.3",
+             tolerance=0.01)
+    sc = Scene("pvdf-60", gravity=False)
+    P = 1e-5
+    tip = settled(sc, force=P)
+    ex.check("simulated 52 mm beam: tip compliance", "m/N", tip[1] / P, sc.layout.length**3 / (3 * 2.703e-5),
+             "L^3 / (3 EI) with the thesis EI", tolerance=0.01)
+    return ex

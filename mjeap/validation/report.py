@@ -1,0 +1,150 @@
+"""The validation report: a console table, JSON, Markdown with figures (matplotlib, optional)
+and one Rerun recording per experiment (curves as time series or 2D line strips, the checks
+as a table)."""
+from __future__ import annotations
+
+import json
+import re
+from pathlib import Path
+from typing import List
+
+import numpy as np
+
+from .core import Experiment
+
+COLUMNS = ("experiment", "quantity", "simulated", "reference", "source", "error", "tolerance", "verdict")
+
+
+def _fmt(x: float) -> str:
+    return "nan" if not np.isfinite(x) else f"{x:.4g}"
+
+
+def _err(c) -> str:
+    if not np.isfinite(c.error):
+        return "inf"
+    return f"{c.error * 100:+.2f} %" if c.error_kind == "relative" else f"{c.error:+.3g} {c.unit}"
+
+
+def _tol(c) -> str:
+    if c.tolerance is None:
+        return "-"
+    return f"{c.tolerance * 100:g} %" if c.error_kind == "relative" else f"{c.tolerance:g} {c.unit}"
+
+
+def rows(experiments: List[Experiment]) -> List[List[str]]:
+    return [[c.experiment, c.quantity, f"{_fmt(c.simulated)} {c.unit}", f"{_fmt(c.reference)} {c.unit}", c.source,
+             _err(c), _tol(c), c.verdict] for ex in experiments for c in ex.checks]
+
+
+def console_table(experiments: List[Experiment], width: int = 60) -> str:
+    def cut(s):
+        return s if len(s) <= width else s[: width - 1] + "~"
+    body = [[cut(x) for x in r] for r in rows(experiments)]
+    w = [max(len(h), *(len(r[i]) for r in body)) if body else len(h) for i, h in enumerate(COLUMNS)]
+    line = lambda r: "  ".join(x.ljust(w[i]) for i, x in enumerate(r))  # noqa: E731
+    return "\n".join([line(COLUMNS), line(["-" * x for x in w])] + [line(r) for r in body])
+
+
+def _slug(s: str) -> str:
+    return re.sub(r"[^A-Za-z0-9_.-]+", "_", s).strip("_")
+
+
+def write_json(experiments: List[Experiment], path: Path) -> None:
+    doc = {"passed": all(e.passed for e in experiments),
+           "experiments": [{"name": e.name, "title": e.title, "seconds": round(e.seconds, 2), "passed": e.passed,
+                            "notes": e.notes, "checks": [c.as_dict() for c in e.checks]} for e in experiments]}
+    path.write_text(json.dumps(doc, indent=1, default=float))
+
+
+def write_figure(ex: Experiment, path: Path) -> bool:
+    """One PNG per experiment, a panel per curve group, axis labels with units and a legend
+    naming each curve's source. Returns False when matplotlib is not installed."""
+    try:
+        import matplotlib
+        matplotlib.use("Agg")
+        import matplotlib.pyplot as plt
+    except ImportError:
+        return False
+    panels = list(dict.fromkeys(c.panel for c in ex.curves))
+    if not panels:
+        return False
+    ncol = min(3, len(panels))
+    nrow = int(np.ceil(len(panels) / ncol))
+    fig, axes = plt.subplots(nrow, ncol, figsize=(5.2 * ncol, 3.6 * nrow), squeeze=False)
+    for ax, panel in zip(axes.flat, panels):
+        for c in (c for c in ex.curves if c.panel == panel):
+            ax.plot(c.x, c.y, c.style, label=c.source, ms=4)
+            ax.set_xlabel(c.xlabel)
+            ax.set_ylabel(c.ylabel)
+        ax.set_title(panel, fontsize=10)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+    for ax in list(axes.flat)[len(panels):]:
+        ax.set_visible(False)
+    fig.suptitle(ex.title, fontsize=11)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return True
+
+
+def write_recording(ex: Experiment, path: Path) -> None:
+    """Curves against time as time series (timeline ``time``), other curves as 2D line strips
+    (x, y in the units of their labels); the checks as a Markdown table."""
+    import rerun as rr
+    import rerun.blueprint as rrb
+    panels = list(dict.fromkeys(c.panel for c in ex.curves))
+    views = []
+    for p in panels:
+        origin = f"/{_slug(p)}"
+        timed = any(c.xlabel.startswith("time") for c in ex.curves if c.panel == p)
+        views.append(rrb.TimeSeriesView(origin=origin, name=p) if timed else rrb.Spatial2DView(origin=origin, name=p))
+    bp = rrb.Blueprint(rrb.Horizontal(rrb.TextDocumentView(origin="/checks", name="checks"),
+                                      rrb.Grid(*views) if views else rrb.Spatial2DView(origin="/"),
+                                      column_shares=[1, 2]), collapse_panels=True)
+    rec = rr.RecordingStream("mjeap-validate", recording_id=ex.name)
+    rec.save(str(path), default_blueprint=bp)
+    try:
+        rec.log("checks", rr.TextDocument(markdown_section(ex, figures=False), media_type="text/markdown"), static=True)
+        palette = [[31, 119, 180], [255, 127, 14], [44, 160, 44], [214, 39, 40], [148, 103, 189], [140, 86, 75]]
+        for i, c in enumerate(ex.curves):
+            ent = f"{_slug(c.panel)}/{_slug(c.source)}"
+            color = palette[i % len(palette)]
+            if c.xlabel.startswith("time"):
+                rec.log(ent, rr.SeriesLines(names=c.source, colors=[color]), static=True)
+                rec.send_columns(ent, indexes=[rr.TimeColumn("time", duration=c.x)],
+                                 columns=rr.Scalars.columns(scalars=c.y))
+            elif c.style.startswith("-") and len(c.x) > 1:
+                rec.log(ent, rr.LineStrips2D([np.column_stack([c.x, c.y])], labels=[c.source], colors=[color]),
+                        static=True)
+            else:
+                rec.log(ent, rr.Points2D(np.column_stack([c.x, c.y]), labels=[c.source], colors=[color],
+                                         radii=[-3.0]), static=True)
+    finally:
+        rec.flush()
+        rec.disconnect()
+
+
+def markdown_section(ex: Experiment, figures: bool = True) -> str:
+    out = [f"## {ex.title}", "", f"`{ex.name}` ({ex.seconds:.1f} s)", ""]
+    out += ["| quantity | simulated | reference | source | error | tolerance | verdict |", "|---|---|---|---|---|---|---|"]
+    for r in rows([ex]):
+        out.append("| " + " | ".join(x.replace("|", "/") for x in r[1:]) + " |")
+    if ex.notes:
+        out += [""] + [f"- {n}" for n in ex.notes]
+    if figures:
+        out += ["", f"![{ex.name}]({ex.name}.png)"]
+    return "\n".join(out) + "\n"
+
+
+def write_markdown(experiments: List[Experiment], path: Path, figures: bool) -> None:
+    n = sum(len(e.checks) for e in experiments)
+    failed = [c for e in experiments for c in e.checks if c.verdict == "FAIL"]
+    toleranced = sum(c.tolerance is not None for e in experiments for c in e.checks)
+    head = ["# mjeap validation report", "",
+            f"{n} rows, {toleranced} with a tolerance, {len(failed)} failed. "
+            "'compare' rows set the simulation beside a published number or a model it is not "
+            "expected to match within a tolerance; their notes say why they differ.", ""]
+    if not figures:
+        head += ["(Figures need matplotlib: `pip install -e '.[report]'`.)", ""]
+    path.write_text("\n".join(head) + "\n".join(markdown_section(e, figures) for e in experiments))
