@@ -348,3 +348,31 @@ class DadrasModel:
             kap[i], reg[i] = k, region
             s = Ad @ s + Bd @ np.array([v[i], Ml])
         return kap, reg
+
+
+def first_frequency_variable(L: float, EI, mass_per_length, guess: float) -> float:
+    """First bending frequency (Hz) of a clamped-free Euler-Bernoulli beam with EI(x) (N m^2)
+    and m(x) (kg/m) given as callables, e.g. a tapered plate: (EI y'')'' = omega^2 m y solved
+    as a boundary-value eigenproblem (scipy solve_bvp, omega^2 an unknown parameter, the
+    tip deflection normalised to 1). ``guess`` (Hz) selects the mode."""
+    L = check_positive("L", L, "m")
+
+    EI0, m0 = float(EI(0.0)), float(mass_per_length(0.0))
+    check_positive("EI(0)", EI0, "N m^2")
+    check_positive("mass_per_length(0)", m0, "kg/m")
+
+    # nondimensional: x = L xi, EI = EI0 e(xi), m = m0 mu(xi), lam = omega^2 m0 L^4 / EI0
+    def rhs(xi, u, p):
+        y, th, M, V = u
+        return np.vstack([th, M / (EI(xi * L) / EI0), V, p[0] * (mass_per_length(xi * L) / m0) * y])
+
+    def bc(u0, u1, p):
+        return np.array([u0[0], u0[1], u1[2], u1[3], u1[0] - 1.0])
+
+    xi = np.linspace(0, 1, 100)
+    lam = (2 * np.pi * guess) ** 2 * m0 * L**4 / EI0
+    u0 = np.vstack([xi**2 * (3 - xi) / 2, 3 * xi * (2 - xi) / 2, 3 * (1 - xi), -3 * np.ones_like(xi)])
+    sol = integrate.solve_bvp(rhs, bc, xi, u0, p=[lam], tol=1e-8, max_nodes=20000)
+    if not sol.success:
+        raise RuntimeError(f"eigenvalue BVP did not converge: {sol.message}")
+    return float(np.sqrt(sol.p[0] * EI0 / (m0 * L**4)) / (2 * np.pi))

@@ -121,16 +121,21 @@ def cmd_mjcf(args) -> int:
     return 0
 
 
-def cmd_rollout(args) -> int:
-    from .rollout import rollout
-    scene = _scene_from_args(args)
+def _params(pairs) -> dict:
     params = {}
-    for kv in args.param or []:
+    for kv in pairs or []:
         k, _, v = kv.partition("=")
         try:
             params[k] = json.loads(v)
         except json.JSONDecodeError:
             params[k] = v
+    return params
+
+
+def cmd_rollout(args) -> int:
+    from .rollout import rollout
+    scene = _scene_from_args(args)
+    params = _params(args.param)
     r = rollout(scene, args.voltage, args.duration, drive=args.drive, drive_params=params,
                 initial_curvature=args.initial_curvature, rrd=args.rrd, csv_path=args.csv,
                 progress=None if not args.quiet else False)
@@ -142,6 +147,48 @@ def cmd_rollout(args) -> int:
                "tip_deflection_final_m": float(r.tip_position[-1, 1]),
                "rrd": args.rrd, "csv": args.csv}
     print(json.dumps(summary, indent=2))
+    return 0
+
+
+def cmd_validate(args) -> int:
+    from .validation import report, run_validation
+    exps = run_validation(args.experiments, out=args.out, quick=args.quick, progress=not args.quiet)
+    print(report.console_table(exps))
+    checks = [c for e in exps for c in e.checks]
+    failed = [c for c in checks if c.verdict == "FAIL"]
+    tol = sum(c.tolerance is not None for c in checks)
+    print(f"\n{len(checks)} rows, {tol} with a tolerance: {tol - len(failed)} pass, {len(failed)} fail"
+          + (f"; report in {args.out}" if args.out else ""))
+    for c in failed:
+        print(f"FAIL {c.experiment}: {c.quantity}: {c.simulated:.6g} vs {c.reference:.6g} {c.unit} ({c.source})")
+    return 1 if failed else 0
+
+
+def cmd_identify_step(args) -> int:
+    from .identify import fit_step_response, read_columns
+    d = read_columns(args.file, [args.time_column, args.curvature_column])
+    fit = fit_step_response(d[args.time_column], d[args.curvature_column], args.voltage, args.t_step)
+    out = {"fit": "kappa(t) = A + B exp(-p t) + C exp(-a t)", "A_per_m": fit.A, "B_per_m": fit.B, "C_per_m": fit.C,
+           "transfer_function": f"K/V = {fit.gain:.4g} (s + {fit.zero:.4g}) / ((s + {fit.pole_mechanical:.4g})"
+                                f"(s + {fit.pole_electrical:.4g}))",
+           "initial_curvature_per_m": fit.initial_curvature, "rms_residual_per_m": fit.rms_residual,
+           "drive": "rc-relaxation", "drive_parameters": fit.drive_parameters(),
+           "use": "mjeap rollout ACTUATOR --drive rc-relaxation " +
+                  " ".join(f"--param {k}={v:.6g}" for k, v in fit.drive_parameters().items())}
+    print(json.dumps(out, indent=2))
+    return 0
+
+
+def cmd_identify_hinges(args) -> int:
+    from .identify import fit_hinge_parameters, read_columns
+    scene = _scene_from_args(args)
+    d = read_columns(args.file, [args.time_column, args.tip_column])
+    fit = fit_hinge_parameters(scene, d[args.time_column], d[args.tip_column], args.voltage, drive=args.drive,
+                               drive_params=_params(args.param))
+    print(json.dumps({"stiffness_N_m_per_rad": fit.stiffness, "stiffness_std": fit.stiffness_std,
+                      "damping_N_m_s_per_rad": fit.damping, "damping_std": fit.damping_std,
+                      "rms_residual_m": fit.rms_residual, "simulations": fit.evaluations,
+                      "segments": scene.layout.segments}, indent=2))
     return 0
 
 
@@ -182,6 +229,30 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--csv", help="write the time series here")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_rollout)
+    p = sub.add_parser("validate", help="run the validation experiments; report, figures and recordings")
+    p.add_argument("experiments", nargs="*", help="experiment names or prefixes (default: all)")
+    p.add_argument("--out", default="out/validation", help="report folder (default: out/validation)")
+    p.add_argument("--quick", action="store_true", help="fewer bisection steps and representations")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_validate)
+    p = sub.add_parser("identify", help="fit the papers' models to measured data (CSV with a header)")
+    isub = p.add_subparsers(dest="what", required=True)
+    q = isub.add_parser("step", help="seed 000: transfer function from a curvature step response")
+    q.add_argument("file")
+    q.add_argument("--voltage", type=float, required=True, help="step amplitude (V)")
+    q.add_argument("--t-step", type=float, default=0.0, help="time of the step (s)")
+    q.add_argument("--time-column", default="time")
+    q.add_argument("--curvature-column", default="tip_curvature")
+    q.set_defaults(func=cmd_identify_step)
+    q = isub.add_parser("hinges", help="seed 001: joint stiffness and damping from a tip trajectory")
+    add_scene_args(q)
+    q.add_argument("file")
+    q.add_argument("--voltage", required=True, help="the waveform applied during the measurement")
+    q.add_argument("--drive", help="drive name (default: the actuator's own)")
+    q.add_argument("--param", action="append", metavar="KEY=VALUE", help="drive parameter (repeatable)")
+    q.add_argument("--time-column", default="time")
+    q.add_argument("--tip-column", default="tip_y", help="tip deflection column (m)")
+    q.set_defaults(func=cmd_identify_hinges)
     return ap
 
 

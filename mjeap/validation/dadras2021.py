@@ -81,6 +81,8 @@ def payloads(quick: bool = False) -> Experiment:
                      note="the payload's weight is positive feedback: a loaded swing above the unloaded one is expected")
             ex.curve(label, "mjeap (hinge chain, payload body)", r.time, r.tip_curvature, "time (s)", KAPPA)
             ex.curve(label, f"{PAPER} Table I model", r.time, kap_model, "time (s)", KAPPA, "--")
+            ex.curve(label, f"{PAPER} eq. (8), unloaded", r.time, MODEL.response(r.time, r.voltage, 0.0, le, k0)[0],
+                     "time (s)", KAPPA, ":")
             ex.rollouts.append((label, r, scene))
     ex.notes += [
         "Table III (the measured peak-to-peak values) is missing from the source text, so the measured "
@@ -104,7 +106,7 @@ def _returns(mass: float, l_e: float, vpp: float = 3.0, periods: int = 3):
     except DivergenceError as e:
         return False, str(e)
     last = r.tip_curvature[r.time >= (periods - 1) * 10.0]
-    ok = bool(last.max() > 0 > last.min() and np.all(np.abs(r.tip_angle) < np.pi / 2))
+    ok = bool(last.max() > 0 > last.min())
     return ok, r
 
 
@@ -150,27 +152,35 @@ def stability(quick: bool = False) -> Experiment:
         ex.check(f"{factor:g} x relaxed buckling load: buckled as the relaxed column predicts", "-",
                  float(grew), float(should_buckle), "relaxed column load", tolerance=0.0, error_kind="absolute")
         ex.rollouts.append((f"{factor:g} x relaxed load at 0 V", r, sc))
+        ex.curve("sustained load at 0 V", f"mjeap, {factor:g} x relaxed column load", r.time, r.tip_curvature,
+                 "time (s)", KAPPA)
     r_lim = m_sim * g / an.buckling_load(le, EI)
     growth = (r_lim * MODEL.zero - MODEL.pole) / (1 - r_lim)
     ex.curve("bisection", "mjeap: returns (1) / does not (0)", np.array(masses) * 1e6, np.array(verdicts, float),
              "payload mass (mg)", "returns", "o")
-    for q, ref, src in refs:
+    for q, ref, src in refs[:4]:
         ex.curve("bisection", src, [ref * 1e6, ref * 1e6], [0, 1], "payload mass (mg)", "returns", "--")
-    _, r = _returns(lo, le)
-    if not isinstance(r, str):
-        ex.rollouts.append((f"{lo * 1e6:.1f} mg (last returning)", r, None))
+    for mass, tag in ((lo, "last returning"), (hi, "first not returning")):
+        _, r = _returns(mass, le)
+        if not isinstance(r, str):
+            ex.rollouts.append((f"{mass * 1e6:.1f} mg ({tag})", r, None))
+            ex.curve("square wave at the limit", f"mjeap, {mass * 1e6:.1f} mg ({tag})", r.time, r.tip_curvature,
+                     "time (s)", KAPPA)
     ex.notes += [
         f"Protocol: standing up, payload centre at l_e = {le * 1e3:.2f} mm, 3 Vpp 0.1 Hz square wave from "
-        "straight, 3 periods; 'returns' = the tip curvature changes sign in the last period and the tip "
-        "never tips past horizontal. Bisection between 12.6 and 200 mg.",
+        "straight, 3 periods; 'returns' = the tip curvature changes sign in the last period (a run that "
+        "diverges does not return). Bisection between 12.6 and 200 mg. Near the limit the tip swings "
+        "past horizontal (tip angle up to 1.6 rad): these are large deflections, far outside the paper's "
+        "linear regions.",
         "Which holds: the simulated beam carries back-relaxation as a standard linear solid whose stiffness "
         "relaxes to EI x 0.3/0.52, so under a sustained load it buckles at the relaxed column load, not "
         "the instantaneous one (the 0 V rows). Between the relaxed and the instantaneous load the column's "
         "stiffness EI (s + p)/(s + z) gives an unstable pole s = (r z - p)/(1 - r), r = P / P_E; "
         f"at the simulated limit (r = {r_lim:.3f}) it grows at {growth:.3f} 1/s (e-folding {1 / growth:.1f} s), "
-        "as slow as the 10 s half-period, so the square wave reverses the drift before it runs away: "
-        "the drive-following limit lies above the static one and depends on the frequency. "
-        " paper's Region 3 pole uses the equivalent "
+        "while the drive's own moment (+-1.5 V alone bends the beam by +-90 1/m) pushes it back through "
+        "straight every half period; as long as the drive wins, the beam keeps returning, so "
+        "the drive-following limit lies above the static one and depends on amplitude and frequency. "
+        "The paper's Region 3 pole uses the equivalent "
         "moment (2/3) l_e F_e, which underestimates the column's destabilising moment (pi^2/4 vs 3/2 l_e^2), "
         "and its model with its own stated numbers gives ~46 mg, not 20 mg: the 20 mg of Fig. 6(c) cannot be "
         "reproduced from eq. (8), Table I and 1/EI = 4.86e7.",

@@ -132,7 +132,7 @@ def markdown_section(ex: Experiment, figures: bool = True) -> str:
         out.append("| " + " | ".join(x.replace("|", "/") for x in r[1:]) + " |")
     if ex.notes:
         out += [""] + [f"- {n}" for n in ex.notes]
-    if figures:
+    if figures and ex.curves:
         out += ["", f"![{ex.name}]({ex.name}.png)"]
     return "\n".join(out) + "\n"
 
