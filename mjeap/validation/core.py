@@ -72,7 +72,7 @@ class Experiment:
     checks: List[Check] = field(default_factory=list)
     curves: List[Curve] = field(default_factory=list)
     notes: List[str] = field(default_factory=list)
-    rollouts: list = field(default_factory=list)   # (label, RolloutResult, Scene) for the recording
+    rollouts: list = field(default_factory=list)   # (label, RolloutResult, clamp rotation or None): beams in the .rrd
     seconds: float = 0.0
 
     def check(self, quantity, unit, simulated, reference, source, tolerance=None, **kw) -> Check:

@@ -10,12 +10,13 @@ import numpy as np
 from scipy import signal
 
 from .. import analytical as an
-from ..discretize import Payload
+from ..discretize import Payload, clamp_rotation
 from ..errors import DivergenceError
 from ..rollout import rollout
 from ..scene import Scene
 from .core import Experiment, experiment
 
+UP = clamp_rotation("up")
 EQ8 = signal.TransferFunction([63.0, 63.0 * 0.52], np.polymul([1, 0.3], [1, 1.8]))
 PAPER = "Dadras et al. 2021 (seed 000)"
 #: Table II: payload (kg), l_e (m), kappa(0-) at 2 Vpp and 3 Vpp (1/m)
@@ -83,7 +84,7 @@ def payloads(quick: bool = False) -> Experiment:
             ex.curve(label, f"{PAPER} Table I model", r.time, kap_model, "time (s)", KAPPA, "--")
             ex.curve(label, f"{PAPER} eq. (8), unloaded", r.time, MODEL.response(r.time, r.voltage, 0.0, le, k0)[0],
                      "time (s)", KAPPA, ":")
-            ex.rollouts.append((label, r, scene))
+            ex.rollouts.append((label, r, scene.rotation))
     ex.notes += [
         "Table III (the measured peak-to-peak values) is missing from the source text, so the measured "
         "numbers cannot be compared; the paper's own model stands in for them, with the paper's stated "
@@ -151,7 +152,7 @@ def stability(quick: bool = False) -> Experiment:
                  note="above 1: the kick grew (buckled); below 1: it decayed (stable)")
         ex.check(f"{factor:g} x relaxed buckling load: buckled as the relaxed column predicts", "-",
                  float(grew), float(should_buckle), "relaxed column load", tolerance=0.0, error_kind="absolute")
-        ex.rollouts.append((f"{factor:g} x relaxed load at 0 V", r, sc))
+        ex.rollouts.append((f"{factor:g} x relaxed load at 0 V", r, sc.rotation))
         ex.curve("sustained load at 0 V", f"mjeap, {factor:g} x relaxed column load", r.time, r.tip_curvature,
                  "time (s)", KAPPA)
     r_lim = m_sim * g / an.buckling_load(le, EI)
@@ -163,7 +164,7 @@ def stability(quick: bool = False) -> Experiment:
     for mass, tag in ((lo, "last returning"), (hi, "first not returning")):
         _, r = _returns(mass, le)
         if not isinstance(r, str):
-            ex.rollouts.append((f"{mass * 1e6:.1f} mg ({tag})", r, None))
+            ex.rollouts.append((f"{mass * 1e6:.1f} mg ({tag})", r, UP))
             ex.curve("square wave at the limit", f"mjeap, {mass * 1e6:.1f} mg ({tag})", r.time, r.tip_curvature,
                      "time (s)", KAPPA)
     ex.notes += [

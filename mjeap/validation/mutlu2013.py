@@ -56,7 +56,7 @@ def chain(quick: bool = False) -> Experiment:
         ex.curve("shapes", f"continuum arc, {v:g} V", fine[:, 0] * 1e3, fine[:, 1] * 1e3, "x (mm)", "y (mm)")
         ex.curve("tip paths", f"mjeap tip, {v:g} V", r.tip_position[::25, 0] * 1e3, r.tip_position[::25, 1] * 1e3,
                  "tip x (mm)", "tip y (mm)", ".")
-        ex.rollouts.append((f"{v:g} V step", r, scene))
+        ex.rollouts.append((f"{v:g} V step", r, scene.rotation))
     ex.curve("tip paths", "continuum arc-tip locus", locus[:, 0] * 1e3, locus[:, 1] * 1e3, "tip x (mm)", "tip y (mm)")
     ex.notes.append(
         f"Drive: blocking force {scene.actuator.id} 0.5 mN/V with a 2 s time constant (estimates, see the "

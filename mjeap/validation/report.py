@@ -1,6 +1,6 @@
 """The validation report: a console table, JSON, Markdown with figures (matplotlib, optional)
 and one Rerun recording per experiment (curves as time series or 2D line strips, the checks
-as a table)."""
+as a table, the simulated beams of the experiment's runs as 3D line strips under /beams)."""
 from __future__ import annotations
 
 import json
@@ -12,6 +12,8 @@ import numpy as np
 
 from .core import Experiment
 
+#: beam frames per simulated run in an experiment's recording
+MAX_BEAM_FRAMES = 300
 COLUMNS = ("experiment", "quantity", "simulated", "reference", "source", "error", "tolerance", "verdict")
 
 
@@ -99,6 +101,8 @@ def write_recording(ex: Experiment, path: Path) -> None:
         origin = f"/{_slug(p)}"
         timed = any(c.xlabel.startswith("time") for c in ex.curves if c.panel == p)
         views.append(rrb.TimeSeriesView(origin=origin, name=p) if timed else rrb.Spatial2DView(origin=origin, name=p))
+    if ex.rollouts:
+        views.append(rrb.Spatial3DView(origin="/beams", name="simulated beams (m)"))
     bp = rrb.Blueprint(rrb.Horizontal(rrb.TextDocumentView(origin="/checks", name="checks"),
                                       rrb.Grid(*views) if views else rrb.Spatial2DView(origin="/"),
                                       column_shares=[1, 2]), collapse_panels=True)
@@ -120,6 +124,14 @@ def write_recording(ex: Experiment, path: Path) -> None:
             else:
                 rec.log(ent, rr.Points2D(np.column_stack([c.x, c.y]), labels=[c.source], colors=[color],
                                          radii=[-3.0]), static=True)
+        for i, (label, r, rotation) in enumerate(ex.rollouts):
+            R = np.eye(3) if rotation is None else np.asarray(rotation)
+            idx = np.arange(0, len(r.time), max(1, len(r.time) // MAX_BEAM_FRAMES))
+            pts = r.centreline[idx] @ R.T
+            ent = f"beams/{_slug(label)}"
+            rec.log(ent, rr.LineStrips3D.from_fields(colors=[palette[i % len(palette)]], labels=[label]), static=True)
+            rec.send_columns(ent, indexes=[rr.TimeColumn("time", duration=r.time[idx])],
+                             columns=rr.LineStrips3D.columns(strips=list(pts)).partition([1] * len(idx)))
     finally:
         rec.flush()
         rec.disconnect()
