@@ -159,4 +159,4 @@ def write_markdown(experiments: List[Experiment], path: Path, figures: bool) -> 
             "expected to match within a tolerance; their notes say why they differ.", ""]
     if not figures:
         head += ["(Figures need matplotlib: `pip install -e '.[report]'`.)", ""]
-    path.write_text("\n".join(head) + "\n".join(markdown_section(e, figures) for e in experiments))
+    path.write_text("\n".join(head) + "\n" + "\n".join(markdown_section(e, figures) for e in experiments))
