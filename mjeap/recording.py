@@ -96,6 +96,10 @@ def write_recording(path, result, scene) -> Path:
                                  columns=rr.Points3D.columns(positions=result.payload_position[idx] @ R.T))
                 rec.log("beam/payload", rr.Points3D.from_fields(radii=[scene.payload.sphere_radius],
                                                                 colors=[[190, 50, 50]]), static=True)
+        for w in result.meta.get("warnings", []):
+            if n:
+                rec.set_time("time", duration=float(t[-1]))
+            rec.log("log", rr.TextLog(w, level="WARN"))
         if "error" in result.meta:
             if n:
                 rec.set_time("time", duration=float(t[-1]))

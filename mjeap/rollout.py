@@ -73,7 +73,7 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
             drive: Union[str, "object", None] = None, drive_params: Optional[dict] = None,
             initial_curvature: float = 0.0, rrd: Union[str, Path, None] = None,
             csv_path: Union[str, Path, None] = None, sample_interval: Optional[float] = None,
-            progress: Optional[bool] = None, check_every: int = 100) -> RolloutResult:
+            progress: Optional[bool] = None, check_every: int = 100, controller=None) -> RolloutResult:
     """Run ``scene`` driven by ``drive`` (name, instance or None for the actuator's own)
     with ``voltage`` (waveform text, :class:`Waveform` or callable v(t)) for ``duration`` s.
 
@@ -87,6 +87,8 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     from . import recording
 
     duration = check_positive("duration", duration, "s")
+    if controller is not None:
+        voltage = 0.0
     wave = parse_waveform(voltage) if isinstance(voltage, (str, Waveform)) else voltage
     if isinstance(wave, Waveform):
         wave = wave.with_duration(duration)
@@ -95,7 +97,7 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     dt = scene.timestep
     n_steps = max(1, int(round(duration / dt)))
     t_steps = np.arange(n_steps) * dt
-    v_steps = np.asarray(wave(t_steps), dtype=float) * np.ones(n_steps)
+    v_steps = np.zeros(n_steps) if controller is not None else np.asarray(wave(t_steps), dtype=float) * np.ones(n_steps)
     drv.check_voltage(v_steps)
     every = max(1, int(round(sample_interval / dt))) if sample_interval else max(1, n_steps // DEFAULT_SAMPLES)
     sample_steps = np.arange(0, n_steps + 1, every)
@@ -103,6 +105,11 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
 
     scene.reset(curvature=initial_curvature)
     drv.reset(initial_curvature)
+    ctrl_every, v_lo, v_hi, saturated, v_hold = n_steps + 1, *drv.voltage_range(), 0, 0.0
+    if controller is not None:
+        controller.reset(scene, drv)
+        ctrl_every = max(1, int(round(getattr(controller, "interval", dt) / dt)))
+        ctrl_name = getattr(controller, "name", type(controller).__name__)
     N = scene.layout.segments
     out_t, out_v = np.empty(ns), np.empty(ns)
     tip, ang, kap = np.empty((ns, 3)), np.empty(ns), np.empty(ns)
@@ -112,7 +119,7 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
 
     def sample(i, step):
         out_t[i] = step * dt
-        out_v[i] = v_steps[min(step, n_steps - 1)]
+        out_v[i] = v_hold if controller is not None else v_steps[min(step, n_steps - 1)]
         tip[i] = scene.tip_position()
         ang[i] = scene.tip_angle()
         kap[i] = arc_curvature(tip[i, 0], tip[i, 1])
@@ -121,6 +128,9 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
             pay[i] = scene.payload_position()
         for k, v in drv.signals().items():
             sig.setdefault(k, np.full(ns, np.nan))[i] = v
+        if controller is not None and hasattr(controller, "signals"):
+            for k, v in controller.signals().items():
+                sig.setdefault(f"controller_{k}", np.full(ns, np.nan))[i] = v
 
     meta = {"actuator": scene.actuator.id, "drive": drv.describe(), "voltage": getattr(wave, "text", str(wave)),
             "duration_s": duration, "initial_curvature_per_m": initial_curvature, "steps": n_steps,
@@ -137,6 +147,12 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
         i_sample = 1
         nxt = sample_steps[1] if ns > 1 else n_steps + 1
         for k in range(n_steps):
+            if controller is not None and k % ctrl_every == 0:
+                u = float(controller(k * dt, scene))
+                v_hold = min(max(u, v_lo), v_hi)
+                saturated += v_hold != u
+            if controller is not None:
+                v_steps[k] = v_hold
             drv.step(v_steps[k], dt)
             step_fn(m, d)
             if (k + 1) % check_every == 0 or k + 1 == nxt:
@@ -144,7 +160,8 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
                     scene._step_count = k + 1
                     scene.check_finite()
                 except DivergenceError as e:
-                    raise DivergenceError(f"{e} Drive: {drv.describe()}, voltage {v_steps[k]:.4g} V.") from None
+                    who = f" Controller: {ctrl_name} (check its gains)." if controller is not None else ""
+                    raise DivergenceError(f"{e} Drive: {drv.describe()}, voltage {v_steps[k]:.4g} V.{who}") from None
             if k + 1 == nxt:
                 sample(i_sample, k + 1)
                 i_sample += 1
@@ -158,6 +175,13 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
         if bar is not None:
             bar.close()
         meta["wall_time_s"] = _time.perf_counter() - wall0
+        if controller is not None:
+            meta["controller"] = ctrl_name
+            meta["saturated_updates"] = int(saturated)
+            if saturated:
+                meta.setdefault("warnings", []).append(
+                    f"{ctrl_name}: {saturated} voltage commands clipped to the safe range [{v_lo:g}, {v_hi:g}] V "
+                    "(reference beyond reach or gains too high)")
         n_ok = i_sample
         ref = None
         if n_ok > 1:
