@@ -84,6 +84,16 @@ def test_run_validation_writes_report_json_figures_and_recordings(tmp_path):
     assert "/checks" in ents and any(k.startswith("/tip_deflection") for k in ents)
 
 
+def test_report_links_a_figure_for_every_experiment_with_curves(tmp_path):
+    """An experiment without curves (mechanics-section) must not switch the figures off for
+    the ones after it."""
+    pytest.importorskip("matplotlib")
+    run_validation(["mechanics-section", "mutlu2013-identify"], out=tmp_path, progress=False)
+    md = (tmp_path / "report.md").read_text()
+    assert "![mutlu2013-identify](mutlu2013-identify.png)" in md and "need matplotlib" not in md
+    assert (tmp_path / "mutlu2013-identify.png").is_file() and not (tmp_path / "mechanics-section.png").exists()
+
+
 def test_validate_exits_nonzero_when_a_toleranced_check_fails(tmp_path, capsys):
     def broken(quick=False):
         ex = Experiment("zz-broken", "a check that must fail")

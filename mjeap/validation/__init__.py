@@ -46,7 +46,7 @@ def run_validation(names: Optional[Iterable[str]] = None, out: Optional[Path] = 
     if out is not None:
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
-    figures = True
+    figures = report.have_matplotlib()
     for name in bar:
         if hasattr(bar, "set_postfix_str"):
             bar.set_postfix_str(name)
@@ -55,7 +55,8 @@ def run_validation(names: Optional[Iterable[str]] = None, out: Optional[Path] = 
         ex.seconds = time.perf_counter() - t0
         done.append(ex)
         if out is not None:
-            figures = report.write_figure(ex, out / f"{ex.name}.png") and figures
+            if figures:
+                report.write_figure(ex, out / f"{ex.name}.png")
             report.write_recording(ex, out / f"{ex.name}.rrd")
             report.write_json(done, out / "validation.json")
             report.write_markdown(done, out / "report.md", figures)

@@ -58,18 +58,21 @@ def write_json(experiments: List[Experiment], path: Path) -> None:
     path.write_text(json.dumps(doc, indent=1, default=float))
 
 
-def write_figure(ex: Experiment, path: Path) -> bool:
-    """One PNG per experiment, a panel per curve group, axis labels with units and a legend
-    naming each curve's source. Returns False when matplotlib is not installed."""
-    try:
-        import matplotlib
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-    except ImportError:
-        return False
+def have_matplotlib() -> bool:
+    """Figures need the optional ``report`` extra."""
+    import importlib.util
+    return importlib.util.find_spec("matplotlib") is not None
+
+
+def write_figure(ex: Experiment, path: Path) -> None:
+    """One PNG per experiment with curves, a panel per curve group, axis labels with units and
+    a legend naming each curve's source. Needs matplotlib (:func:`have_matplotlib`)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
     panels = list(dict.fromkeys(c.panel for c in ex.curves))
     if not panels:
-        return False
+        return
     ncol = min(3, len(panels))
     nrow = int(np.ceil(len(panels) / ncol))
     fig, axes = plt.subplots(nrow, ncol, figsize=(5.2 * ncol, 3.6 * nrow), squeeze=False)
@@ -87,7 +90,6 @@ def write_figure(ex: Experiment, path: Path) -> bool:
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
-    return True
 
 
 def write_recording(ex: Experiment, path: Path) -> None:
