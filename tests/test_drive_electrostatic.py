@@ -110,7 +110,7 @@ def test_tip_extension_calibration_reaches_table_1(actuator, f_table):
     checked independently: free vibration of the calibrated scene rings at Table 1's
     frequency within 2 %, and the calibrated free deflection follows Wood's (1 + 2 l_r)."""
     from mjeap.calibration import calibrate_tip_extension
-    from test_dynamics import measured_frequency
+    from mjeap.validation.mechanics import free_vibration_frequency as measured_frequency
     cal = calibrate_tip_extension(actuator, f_table)
     assert 0 < cal.extension_length < 2 * cal.actuator.length
     s = Scene(cal.actuator, damping_ratio=0.005)

@@ -3,27 +3,7 @@ import numpy as np
 import pytest
 
 from mjeap import Payload, Scene, analytical as an
-
-
-def measured_frequency(scene, periods=12):
-    """Free vibration after a small tip displacement: frequency from the mean spacing of
-    upward zero crossings of the tip deflection (Hz)."""
-    scene.reset()
-    f_guess = scene.choice.first_frequency
-    # static shape of a small tip force as the initial condition, then release
-    scene.set_tip_force(1e-3 * scene.layout.length * an.lateral_stiffness(
-        scene.layout.length, float(scene.actuator.flexural_rigidity_at(0)[0])))
-    scene.settle(tol=1e-10)
-    scene.set_tip_force(0.0)
-    scene.data.time = 0.0
-    n = int(periods / f_guess / scene.timestep)
-    t, y = np.empty(n), np.empty(n)
-    for i in range(n):
-        scene.step()
-        t[i], y[i] = scene.time, scene.tip_position()[1]
-    up = np.where((y[:-1] < 0) & (y[1:] >= 0))[0]
-    tc = t[up] - y[up] * (t[up + 1] - t[up]) / (y[up + 1] - y[up])
-    return 1.0 / np.mean(np.diff(tc))
+from mjeap.validation.mechanics import free_vibration_frequency as measured_frequency
 
 
 @pytest.mark.parametrize("representation", ["hinge", "cable"])

@@ -3,17 +3,10 @@ import numpy as np
 import pytest
 
 from mjeap import Scene, analytical as an
+from mjeap.validation.mechanics import settled as settled_tip
 
 ACT = "pedot-micro"
 L, EI = 6e-3, 1 / 4.86e7
-
-
-def settled_tip(scene, force=0.0, moment=0.0):
-    scene.reset()
-    scene.set_tip_force(force)
-    scene.set_tip_moment(moment)
-    scene.settle(tol=1e-9)
-    return scene.tip_position()
 
 
 @pytest.fixture(scope="module", params=["hinge", "cable"])

@@ -16,6 +16,7 @@ G = 9.81
 
 
 def settled(scene, force=0.0, moment=0.0):
+    """Tip position (m, clamp frame) at static equilibrium under a dead tip force and couple."""
     scene.reset()
     scene.set_tip_force(force)
     scene.set_tip_moment(moment)
@@ -24,7 +25,8 @@ def settled(scene, force=0.0, moment=0.0):
 
 
 def free_vibration_frequency(scene, periods: int = 12) -> float:
-    """Mean spacing of upward zero crossings of the tip deflection after release (Hz)."""
+    """First frequency (Hz) from free vibration: released from the static shape of a small tip
+    force, the mean spacing of upward zero crossings of the tip deflection."""
     scene.reset()
     scene.set_tip_force(1e-3 * scene.layout.length * an.lateral_stiffness(
         scene.layout.length, float(scene.actuator.flexural_rigidity_at(0)[0])))
