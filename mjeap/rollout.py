@@ -87,9 +87,8 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     from . import recording
 
     duration = check_positive("duration", duration, "s")
-    if controller is not None:
-        voltage = 0.0
-    wave = parse_waveform(voltage) if isinstance(voltage, (str, Waveform)) else voltage
+    wave = None if controller is not None else \
+        parse_waveform(voltage) if isinstance(voltage, (str, Waveform)) else voltage
     if isinstance(wave, Waveform):
         wave = wave.with_duration(duration)
     drv = drive if (drive is not None and not isinstance(drive, str)) else \
@@ -97,7 +96,7 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     dt = scene.timestep
     n_steps = max(1, int(round(duration / dt)))
     t_steps = np.arange(n_steps) * dt
-    v_steps = np.zeros(n_steps) if controller is not None else np.asarray(wave(t_steps), dtype=float) * np.ones(n_steps)
+    v_steps = np.zeros(n_steps) if wave is None else np.asarray(wave(t_steps), dtype=float) * np.ones(n_steps)
     drv.check_voltage(v_steps)
     every = max(1, int(round(sample_interval / dt))) if sample_interval else max(1, n_steps // DEFAULT_SAMPLES)
     sample_steps = np.arange(0, n_steps + 1, every)
@@ -132,7 +131,7 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
             for k, v in controller.signals().items():
                 sig.setdefault(f"controller_{k}", np.full(ns, np.nan))[i] = v
 
-    meta = {"actuator": scene.actuator.id, "drive": drv.describe(), "voltage": getattr(wave, "text", str(wave)),
+    meta = {"actuator": scene.actuator.id, "drive": drv.describe(), "voltage": "closed loop" if wave is None else getattr(wave, "text", str(wave)),
             "duration_s": duration, "initial_curvature_per_m": initial_curvature, "steps": n_steps,
             "scene": scene.summary(), "drive_parameters": {k: [v, drv.sources.get(k, "")] for k, v in drv.params.items()}}
     show = (n_steps > PROGRESS_STEPS) if progress is None else progress
@@ -147,11 +146,11 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
         i_sample = 1
         nxt = sample_steps[1] if ns > 1 else n_steps + 1
         for k in range(n_steps):
-            if controller is not None and k % ctrl_every == 0:
-                u = float(controller(k * dt, scene))
-                v_hold = min(max(u, v_lo), v_hi)
-                saturated += v_hold != u
             if controller is not None:
+                if k % ctrl_every == 0:
+                    u = float(controller(k * dt, scene))
+                    v_hold = min(max(u, v_lo), v_hi)
+                    saturated += v_hold != u
                 v_steps[k] = v_hold
             drv.step(v_steps[k], dt)
             step_fn(m, d)
