@@ -116,16 +116,16 @@ def stability(quick: bool = False) -> Experiment:
     ex = Experiment("dadras2021-stability", "PEDOT micro trilayer standing up: largest payload that still returns")
     le = 6.27e-3
     lo, hi = 12.6e-6, 200e-6
-    ok_hi, _ = _returns(hi, le)
-    if ok_hi:
+    runs = {m: _returns(m, le) for m in (lo, hi)}   # mass -> (returns, result or error text)
+    if runs[hi][0]:
         raise AssertionError("the stability sweep's upper bracket (200 mg) still returns")
-    masses, verdicts = [lo], [_returns(lo, le)[0]]
+    masses = [lo]
     for _ in range(5 if quick else 7):
         mid = 0.5 * (lo + hi)
-        ok, _ = _returns(mid, le)
+        runs[mid] = _returns(mid, le)
         masses.append(mid)
-        verdicts.append(ok)
-        lo, hi = (mid, hi) if ok else (lo, mid)
+        lo, hi = (mid, hi) if runs[mid][0] else (lo, mid)
+    verdicts = [runs[m][0] for m in masses]
     m_sim = 0.5 * (lo + hi)
     relaxed = MODEL.pole / MODEL.zero
     g = MODEL.gravity
@@ -162,7 +162,7 @@ def stability(quick: bool = False) -> Experiment:
     for q, ref, src in refs[:4]:
         ex.curve("bisection", src, [ref * 1e6, ref * 1e6], [0, 1], "payload mass (mg)", "returns", "--")
     for mass, tag in ((lo, "last returning"), (hi, "first not returning")):
-        _, r = _returns(mass, le)
+        r = runs[mass][1]
         if not isinstance(r, str):
             ex.rollouts.append((f"{mass * 1e6:.1f} mg ({tag})", r, UP))
             ex.curve("square wave at the limit", f"mjeap, {mass * 1e6:.1f} mg ({tag})", r.time, r.tip_curvature,
