@@ -36,7 +36,9 @@ PROGRESS_STEPS = 200_000
 @dataclass
 class RolloutResult:
     """Sampled SI arrays of a rollout. Positions are in the clamp frame (x along the
-    undeformed beam, y the deflection, z out of the bending plane)."""
+    undeformed beam, y the deflection, z out of the bending plane). Sample i is the state
+    after step k; its voltage is the one held over that step (zero-order hold), the same
+    instant the drive signals describe."""
 
     time: np.ndarray                 # (n,) s
     voltage: np.ndarray              # (n,) V
@@ -117,8 +119,11 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     sig: Dict[str, np.ndarray] = {}
 
     def sample(i, step):
+        scene.update_kinematics()
         out_t[i] = step * dt
-        out_v[i] = v_hold if controller is not None else v_steps[min(step, n_steps - 1)]
+        # the voltage held over the step that ended at this sample (the first sample: the
+        # first step's), the same convention as the drive signals read now
+        out_v[i] = v_hold if controller is not None else v_steps[max(step - 1, 0)]
         tip[i] = scene.tip_position()
         ang[i] = scene.tip_angle()
         kap[i] = arc_curvature(tip[i, 0], tip[i, 1])
@@ -148,6 +153,7 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
         for k in range(n_steps):
             if controller is not None:
                 if k % ctrl_every == 0:
+                    scene.update_kinematics()
                     u = float(controller(k * dt, scene))
                     v_hold = min(max(u, v_lo), v_hi)
                     saturated += v_hold != u

@@ -56,29 +56,37 @@ class PiezoBimorphDrive(Drive):
         w = scene.layout.hinge_width
         self.gamma = 0.5 * self.params["f31"] * w * (self.t_p + self.t_cf)   # N m / V per hinge
         self._v_prev = None
-        self._i = np.zeros(3)
+        self._v = self._dv = 0.0
+        self._m = np.zeros(scene.layout.segments)
 
     def voltage_range(self):
         return (0.0, float(self.params["bias"]))
 
     def reset(self, initial_curvature: float = 0.0) -> None:
         self._v_prev = None
+        self._v = 0.5 * self.params["bias"]
+        self._dv = 0.0
         self.scene.set_internal_moments(0.0)
         self._m = np.zeros(self.scene.layout.segments)
 
     def step(self, voltage: float, dt: float) -> None:
-        vb = self.params["bias"]
-        self._m = self.gamma * (voltage - 0.5 * vb)
+        self._m = self.gamma * (voltage - 0.5 * self.params["bias"])
         self.scene.set_internal_moments(self._m)
-        dv = 0.0 if self._v_prev is None else (voltage - self._v_prev) / dt
-        i_mech = float(self.gamma @ self.scene.hinge_rates())
-        self._i = np.array([(2 * voltage - vb) / (2 * self.params["resistance"]),
-                            self.params["capacitance"] * dv, i_mech])
-        self._v_prev = voltage
+        self._dv = 0.0 if self._v_prev is None else (voltage - self._v_prev) / dt
+        self._v = self._v_prev = voltage
+
+    def currents(self):
+        """(resistive, capacitive, motional) current of eq. (1), A, at the scene's present
+        state: the voltage held over the last step, its backward difference over that step
+        (what a sampled dV/dt sees) and the hinge rates now."""
+        vb = self.params["bias"]
+        return ((2 * self._v - vb) / (2 * self.params["resistance"]), self.params["capacitance"] * self._dv,
+                float(self.gamma @ self.scene.hinge_rates()))
 
     def signals(self) -> Dict[str, float]:
-        return {"current (A)": float(self._i.sum()), "current_resistive (A)": float(self._i[0]),
-                "current_capacitive (A)": float(self._i[1]), "current_motional (A)": float(self._i[2]),
+        i_r, i_c, i_m = self.currents()
+        return {"current (A)": i_r + i_c + i_m, "current_resistive (A)": i_r,
+                "current_capacitive (A)": i_c, "current_motional (A)": i_m,
                 "drive_moment_root (N m)": float(self._m[0])}
 
     # ---- Wood / Jafferis formulas -------------------------------------------------
