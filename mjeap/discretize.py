@@ -29,8 +29,8 @@ MAX_PAYLOAD_OVERHANG = 0.25
 @dataclass(frozen=True)
 class Payload:
     """A rigid tip payload: ``mass`` (kg) centred ``position`` (m) from the clamp along the
-    beam (seed 000's effective length l_e; it may overhang the tip by up to 25 % of L, a
-    magnet stuck on the tip). ``radius`` (m) of the sphere giving its rotary inertia; by
+    beam (seed 000's effective length l_e; it may sit on a rigid tip extension and overhang
+    the tip by up to 25 % of L, a magnet stuck on the tip). ``radius`` (m) of the sphere giving its rotary inertia; by
     default that of an NdFeB sphere of the same mass."""
 
     mass: float
@@ -166,8 +166,8 @@ def discretize(act: Actuator, segments: int) -> BeamLayout:
 def check_payload(payload: Optional[Payload], layout: BeamLayout) -> None:
     if payload is None:
         return
-    check_range("payload.position", payload.position, 0.0, layout.length * (1 + MAX_PAYLOAD_OVERHANG), "m",
-                lo_open=True)
+    check_range("payload.position", payload.position, 0.0,
+                layout.tip_x + layout.length * MAX_PAYLOAD_OVERHANG, "m", lo_open=True)
 
 
 ORIENTATIONS: Tuple[str, ...] = ("horizontal", "up", "down")

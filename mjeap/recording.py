@@ -48,14 +48,21 @@ def blueprint():
     )
 
 
-def write_recording(path, result, scene) -> Path:
+def write_recording(path, result, scene, extra=None, views=()) -> Path:
     """Write ``result`` of a rollout of ``scene`` to ``path`` (.rrd); the file is flushed
-    and closed before returning, also for a failed (partial) run."""
+    and closed before returning, also for a failed (partial) run. ``extra(rec)`` may log
+    more entities to the open ``rerun.RecordingStream``; ``views`` (rerun blueprint views)
+    are added to the default layout for them."""
     import rerun as rr
+    import rerun.blueprint as rrb
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     rec = rr.RecordingStream("mjeap", recording_id=f"{scene.actuator.id}-{result.meta.get('drive', '')}")
-    rec.save(str(path), default_blueprint=blueprint())
+    bp = blueprint()
+    if views:
+        bp = rrb.Blueprint(rrb.Vertical(bp.root_container, rrb.Horizontal(*views)),
+                           rrb.BlueprintPanel(state="collapsed"), rrb.SelectionPanel(state="collapsed"))
+    rec.save(str(path), default_blueprint=bp)
     try:
         t = result.time
         R = scene.rotation  # clamp frame -> world
@@ -104,6 +111,8 @@ def write_recording(path, result, scene) -> Path:
             if n:
                 rec.set_time("time", duration=float(t[-1]))
             rec.log("log", rr.TextLog(result.meta["error"], level="ERROR"))
+        if extra is not None:
+            extra(rec)
     finally:
         rec.flush()
         rec.disconnect()
