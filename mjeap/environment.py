@@ -1,0 +1,228 @@
+"""A dm_env environment through dm_control: ``control.Environment`` with a :class:`Task`.
+
+:class:`BeamPhysics` is a dm_control ``Physics`` on a :class:`mjeap.Scene`'s model and data
+whose ``step`` runs the drive in lockstep with MuJoCo (one drive update per MuJoCo step,
+the voltage held over the control interval), so ``control.Environment``'s sub-steps keep the
+drive exact. :class:`CurvatureTrackingTask` gives the action (drive voltage, V, inside the
+drive's safe range), the observations (SI) and a configurable tracking reward, and
+randomises payload mass and initial curvature per episode from its seeded generator.
+
+The payload is randomised in place (``model.body_mass`` and its inertia, then
+``mj_setConst``): timestep and Rayleigh damping stay those chosen for the scene's nominal
+payload, so the first mode's damping ratio drifts with the mass (zeta ~ omega_1). Keep the
+mass range below the actuator's stability limit (``mjeap validate`` reports it).
+"""
+from __future__ import annotations
+
+import collections
+import warnings
+from typing import Callable, Optional, Tuple
+
+import mujoco
+import numpy as np
+from dm_control.mujoco import engine, wrapper
+from dm_control.rl import control
+from dm_control.suite import base
+from dm_control.utils import rewards
+from dm_env import specs
+
+from .discretize import Payload
+from .drives import make_drive
+from .errors import ParameterError, check_positive, check_range
+from .scene import Scene
+
+
+class BeamPhysics(engine.Physics):
+    """dm_control Physics sharing a Scene's MjModel and MjData; stepping also steps the drive."""
+
+    @classmethod
+    def from_scene(cls, scene: Scene, drive) -> "BeamPhysics":
+        physics = cls.from_model(wrapper.MjModel(scene.model))
+        scene.data = physics.data.ptr       # the scene's read-outs now see the physics' state
+        physics.scene, physics.drive, physics.voltage = scene, drive, 0.0
+        return physics
+
+    def timestep(self) -> float:
+        """MuJoCo timestep in s (the model runs in scaled internal units)."""
+        return self.scene.timestep
+
+    def time(self) -> float:
+        """Simulated time in s."""
+        return self.scene.time
+
+    def step(self, nstep: int = 1) -> None:
+        m, d, dt = self.model.ptr, self.data.ptr, self.scene.timestep
+        with self.check_invalid_state():
+            for _ in range(nstep):
+                self.drive.step(self.voltage, dt)
+                mujoco.mj_step(m, d)
+        self.scene._step_count += nstep
+        self.scene.check_finite()
+        self.scene.update_kinematics()
+
+
+class CurvatureTrackingTask(base.Task):
+    """Track ``reference(t)`` (1/m) with the tip curvature. Reward per step:
+    ``reward_fn(kappa, kappa_ref)``, default a Gaussian of the error with width
+    ``reward_margin`` (1/m), 1 on target (dm_control.utils.rewards.tolerance).
+
+    Randomised at every reset (``random``: seed or numpy Generator/RandomState): the payload
+    mass uniformly in ``payload_mass_range`` (kg, needs a scene with a payload), the initial
+    curvature uniformly in ``initial_curvature_range`` (1/m). Actions outside the safe range
+    are clipped, counted in ``saturated_steps`` and warned about once per episode."""
+
+    def __init__(self, reference: Callable[[float], float], payload_mass_range: Optional[Tuple[float, float]] = None,
+                 initial_curvature_range: Tuple[float, float] = (0.0, 0.0), reward_margin: float = 5.0,
+                 reward_fn: Optional[Callable[[float, float], float]] = None, random=None):
+        super().__init__(random=random)
+        self.reference = reference
+        if payload_mass_range is not None:
+            lo, hi = (float(x) for x in payload_mass_range)
+            if not (0 < lo <= hi):
+                raise ParameterError("payload_mass_range", payload_mass_range, "(low, high) kg with 0 < low <= high")
+        self.payload_mass_range = payload_mass_range
+        lo, hi = (float(x) for x in initial_curvature_range)
+        if lo > hi:
+            raise ParameterError("initial_curvature_range", initial_curvature_range, "(low, high) 1/m with low <= high")
+        self.initial_curvature_range = (lo, hi)
+        self.reward_margin = check_positive("reward_margin", reward_margin, "1/m")
+        self.reward_fn = reward_fn
+        self.saturated_steps = 0
+        self.episode = {}
+
+    # -- episode -----------------------------------------------------------------------
+    def initialize_episode(self, physics: BeamPhysics) -> None:
+        sc, m = physics.scene, physics.model.ptr
+        self.episode = {}
+        if self.payload_mass_range is not None:
+            if sc.payload_id < 0:
+                raise ParameterError("payload_mass_range", self.payload_mass_range,
+                                     "None for a scene without a payload (give the scene a nominal payload)")
+            mass = float(self.random.uniform(*self.payload_mass_range))
+            u = sc.units
+            m.body_mass[sc.payload_id] = mass / u.mass
+            m.body_inertia[sc.payload_id] = Payload(mass, sc.payload.position, sc.payload.sphere_radius).inertia / u.inertia
+            mujoco.mj_setConst(m, physics.data.ptr)
+            self.episode["payload_mass_kg"] = mass
+        kappa0 = float(self.random.uniform(*self.initial_curvature_range))
+        self.episode["initial_curvature_per_m"] = kappa0
+        if kappa0:
+            sc.set_hinge_angles(np.full(sc.layout.segments, kappa0 * sc.layout.ds))
+        sc._step_count = 0
+        physics.drive.reset(kappa0)
+        physics.voltage = 0.5 * sum(physics.drive.voltage_range()) if physics.drive.name == "piezo-bimorph" else 0.0
+        self.saturated_steps, self._warned = 0, False
+        self._signal_names = list(physics.drive.signals())
+
+    def action_spec(self, physics: BeamPhysics):
+        lo, hi = physics.drive.voltage_range()
+        return specs.BoundedArray((1,), np.float64, lo, hi, name="voltage (V)")
+
+    def before_step(self, action, physics: BeamPhysics) -> None:
+        u = float(np.asarray(action, dtype=float).reshape(-1)[0])
+        if not np.isfinite(u):
+            raise ParameterError("action", u, "a finite voltage in V")
+        lo, hi = physics.drive.voltage_range()
+        v = min(max(u, lo), hi)
+        if v != u:
+            self.saturated_steps += 1
+            if not self._warned:
+                warnings.warn(f"action {u:.4g} V clipped to the safe range [{lo:g}, {hi:g}] V of "
+                              f"{physics.scene.actuator.id}", stacklevel=2)
+                self._warned = True
+        physics.voltage = v
+
+    # -- read-outs ---------------------------------------------------------------------
+    def get_observation(self, physics: BeamPhysics):
+        sc = physics.scene
+        sig = physics.drive.signals()
+        obs = collections.OrderedDict()
+        obs["tip_curvature"] = np.array([sc.tip_curvature()])                 # 1/m
+        obs["reference"] = np.array([float(self.reference(sc.time))])          # 1/m
+        obs["tip_position"] = sc.tip_position()                               # m, clamp frame
+        obs["drive_state"] = np.array([sig[k] for k in self._signal_names])  # SI, see drive_state_names
+        if "current (A)" in sig:
+            obs["current"] = np.array([sig["current (A)"]])                   # A
+        return obs
+
+    @property
+    def drive_state_names(self):
+        return list(self._signal_names)
+
+    def get_reward(self, physics: BeamPhysics) -> float:
+        sc = physics.scene
+        k, ref = sc.tip_curvature(), float(self.reference(sc.time))
+        if self.reward_fn is not None:
+            return float(self.reward_fn(k, ref))
+        return float(rewards.tolerance(k - ref, bounds=(0.0, 0.0), margin=self.reward_margin, sigmoid="gaussian"))
+
+
+def make_environment(actuator: str = "pedot-micro", reference: Optional[Callable[[float], float]] = None,
+                     orientation: str = "up", payload: Optional[Payload] = Payload(12.6e-6, 6.27e-3),
+                     payload_mass_range: Optional[Tuple[float, float]] = None,
+                     initial_curvature_range: Tuple[float, float] = (0.0, 0.0), control_interval: float = 1e-2,
+                     time_limit: float = 20.0, seed=None, drive: Optional[str] = None, drive_params=None,
+                     reward_margin: float = 5.0, segments: int = 20) -> control.Environment:
+    """A ``dm_control.rl.control.Environment`` tracking ``reference(t)`` (1/m; default: a
+    0.05 Hz sine of 50 1/m, seed 000's closed-loop case) with ``actuator``. The agent acts
+    every ``control_interval`` s (rounded to whole MuJoCo steps) for ``time_limit`` s."""
+    if reference is None:
+        def reference(t):
+            return 50.0 * np.sin(2 * np.pi * 0.05 * t)
+    scene = Scene(actuator, orientation=orientation, payload=payload, segments=segments)
+    drv = make_drive(drive, scene, **(drive_params or {}))
+    check_range("control_interval", control_interval, scene.timestep, time_limit, "s")
+    physics = BeamPhysics.from_scene(scene, drv)
+    task = CurvatureTrackingTask(reference, payload_mass_range, initial_curvature_range, reward_margin,
+                                 random=seed)
+    n_sub = max(1, int(round(control_interval / scene.timestep)))
+    return control.Environment(physics, task, time_limit=time_limit, n_sub_steps=n_sub)
+
+
+def run_episode(env: control.Environment, policy: Callable, rrd=None):
+    """Run one episode of ``env`` with ``policy(time_step) -> action`` and return it as a
+    :class:`mjeap.RolloutResult` sampled at every agent step (the reward and the action as
+    signals), written to ``rrd`` if given (also when the episode fails)."""
+    from .analytical import arc_curvature
+    from .recording import write_recording
+    from .rollout import RolloutResult
+
+    physics, task = env.physics, env.task
+    sc = physics.scene
+    rows, error = [], None
+
+    def sample(ts, action):
+        p = sc.tip_position()
+        sig = dict(physics.drive.signals())
+        sig["reward (-)"] = np.nan if ts.reward is None else float(ts.reward)
+        sig["reference_curvature (1/m)"] = float(task.reference(sc.time))
+        rows.append((sc.time, physics.voltage, p, sc.tip_angle(), arc_curvature(p[0], p[1]), sc.centreline(),
+                     sc.payload_position(), sig))
+
+    try:
+        ts = env.reset()
+        sample(ts, None)
+        while not ts.last():
+            action = policy(ts)
+            ts = env.step(action)
+            sample(ts, action)
+    except BaseException as e:
+        error = e
+        raise
+    finally:
+        t, v, p, a, k, cl, pay, sig = zip(*rows) if rows else ([],) * 8
+        keys = list(sig[0]) if rows else []
+        meta = {"actuator": sc.actuator.id, "drive": physics.drive.describe(), "voltage": "agent",
+                "episode": dict(task.episode), "saturated_steps": task.saturated_steps,
+                "control_interval_s": env.control_timestep(), "scene": sc.summary()}
+        if task.saturated_steps:
+            meta["warnings"] = [f"{task.saturated_steps} actions clipped to the safe range "
+                                f"{physics.drive.voltage_range()} V"]
+        if error is not None:
+            meta["error"] = f"{type(error).__name__}: {error}"
+        result = RolloutResult(np.array(t), np.array(v), np.array(p), np.array(a), np.array(k), np.array(cl),
+                               None if (not rows or pay[0] is None) else np.array(pay),
+                               {kk: np.array([s[kk] for s in sig]) for kk in keys}, None, meta)
+        if rrd is not None and rows:
+            write_recording(rrd, result, sc)
+    return result
