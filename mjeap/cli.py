@@ -7,7 +7,9 @@ import sys
 from pathlib import Path
 from typing import List, Optional
 
-from .errors import MjeapError
+import numpy as np
+
+from .errors import MjeapError, ParameterError
 
 
 def _fmt(v: float) -> str:
@@ -205,6 +207,48 @@ def add_scene_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("--integrator", choices=list(INTEGRATORS), default="implicitfast")
 
 
+def _value(text: str):
+    """A number if it parses as one, else the text (actuator ids, orientations, ...)."""
+    try:
+        return float(text)
+    except ValueError:
+        return text
+
+
+def _sweep_values(spec: str, random: bool):
+    """NAME=a,b,c (list) | NAME=lo:hi:n (n values, linspace) | NAME=lo..hi (random range)."""
+    name, sep, rhs = spec.partition("=")
+    if not sep or not rhs:
+        raise ParameterError("--vary", spec, "NAME=a,b,c or NAME=lo:hi:n (grid) or NAME=lo..hi (with --random)")
+    name = name.strip()
+    if ".." in rhs:
+        if not random:
+            raise ParameterError("--vary", spec, "a range lo..hi only with --random N")
+        lo, hi = (float(x) for x in rhs.split(".."))
+        return name, (lo, hi)
+    if rhs.count(":") == 2:
+        lo, hi, n = rhs.split(":")
+        return name, [float(x) for x in np.linspace(float(lo), float(hi), int(n))]
+    return name, [_value(v) for v in rhs.split(",")]
+
+
+def cmd_sweep(args) -> int:
+    from . import sweep
+    values = dict(_sweep_values(v, args.random is not None) for v in (args.vary or []))
+    if not values:
+        raise ParameterError("--vary", None, "at least one NAME=VALUES")
+    points = sweep.random_design(args.random, args.seed, **values) if args.random is not None else \
+        sweep.grid(**values)
+    base = {k: _value(v) for k, v in (kv.partition("=")[::2] for kv in (args.set or []))}
+    record = [int(i) for i in args.record.split(",")] if args.record else []
+    s = sweep.run_sweep(points, args.out, metrics=args.metrics.split(","), base=base, executor=args.executor,
+                        workers=args.workers, scheduler=args.scheduler, record=record, progress=not args.quiet)
+    print(json.dumps({"results": str(s.path), "points": len(points), "ran": s.done, "skipped (already in the file)":
+                      s.skipped, "failed": s.failed, "wall_s": round(s.wall_s, 3),
+                      "rollouts_per_s": round(s.throughput, 3) if s.done else None}, indent=2))
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="mjeap", description=__doc__)
     sub = ap.add_subparsers(dest="command", required=True)
@@ -235,6 +279,22 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--quick", action="store_true", help="fewer bisection steps and representations")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_validate)
+    p = sub.add_parser("sweep", help="parameter study: rollouts reduced to metrics, streamed to CSV, resumable")
+    p.add_argument("--vary", action="append", metavar="NAME=VALUES",
+                   help="a,b,c | lo:hi:n (grid) | lo..hi (with --random); NAME is a point parameter "
+                        "(actuator, payload_mass, amplitude, frequency, segments, ...) or drive.NAME (repeatable)")
+    p.add_argument("--set", action="append", metavar="NAME=VALUE", help="fixed parameter for every point (repeatable)")
+    p.add_argument("--random", type=int, metavar="N", help="N random points instead of the full grid")
+    p.add_argument("--seed", type=int, default=0, help="seed of the random design")
+    p.add_argument("--metrics", default="peak_to_peak,returns",
+                   help="comma list: peak_to_peak, returns, settling_time, max_stress_proxy, max_tip_deflection")
+    p.add_argument("--out", default="out/sweep.csv", help="results CSV (appended; finished points are skipped)")
+    p.add_argument("--executor", choices=["processes", "serial", "dask"], default="processes")
+    p.add_argument("--workers", type=int, default=2, help="worker processes (local pool or Dask LocalCluster)")
+    p.add_argument("--scheduler", help="Dask scheduler address (tcp://host:8786); default: a LocalCluster")
+    p.add_argument("--record", help="comma list of point indices that also write a .rrd")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_sweep)
     p = sub.add_parser("identify", help="fit the papers' models to measured data (CSV with a header)")
     isub = p.add_subparsers(dest="what", required=True)
     q = isub.add_parser("step", help="seed 000: transfer function from a curvature step response")

@@ -1,0 +1,299 @@
+"""Parameter sweeps: a design of points, each a rollout reduced to named metrics, run on
+local processes or on Dask, streamed to CSV as they complete and resumable.
+
+A point is a dict of :data:`PARAMETERS` (scene, waveform and rollout settings, SI) plus
+``drive.NAME`` entries for drive parameters. :func:`grid` and :func:`random_design` make
+designs; :func:`run_sweep` evaluates them. Every finished point is appended to the CSV
+(and flushed) at once, keyed by a hash of its parameters, so an interrupted sweep keeps what
+finished and a rerun with the same file skips it. A point that fails (bad input, divergence)
+records its error in the ``error`` column instead of stopping the sweep.
+
+Executors: ``"processes"`` (``concurrent.futures``, the default), ``"serial"``, and
+``"dask"``: a ``distributed.Client`` on ``scheduler`` (an address such as
+``tcp://host:8786``) or, without one, on a ``LocalCluster`` of ``workers`` processes. The
+same code runs on all three; Dask is the optional ``sweep`` extra.
+"""
+from __future__ import annotations
+
+import csv
+import hashlib
+import itertools
+import json
+import os
+import time
+import traceback
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Callable, Dict, Iterable, List, Optional, Sequence
+
+import numpy as np
+
+from .errors import MjeapError, ParameterError, UnknownNameError
+
+#: point parameters and their defaults (SI); ``drive.NAME`` entries go to the drive
+PARAMETERS: Dict[str, object] = {
+    "actuator": "pedot-micro", "representation": "hinge", "segments": 20, "orientation": "horizontal",
+    "payload_mass": 0.0, "payload_position": None, "waveform": "square", "amplitude": 1.0, "frequency": 0.1,
+    "offset": 0.0, "duration": None, "initial_curvature": 0.0, "damping_ratio": None,
+}
+
+
+def _last_period(r, point):
+    f = point.get("frequency") or 0.0
+    t_end = r.time[-1]
+    t0 = t_end - 1.0 / f if f > 0 and 1.0 / f < t_end else 0.5 * t_end
+    return r.time >= t0
+
+
+def metric_peak_to_peak(r, point, scene) -> float:
+    """Peak-to-peak tip curvature (1/m) over the last drive period (the second half of the
+    run without a frequency)."""
+    return float(np.ptp(r.tip_curvature[_last_period(r, point)]))
+
+
+def metric_returns(r, point, scene) -> bool:
+    """Seed 000's stability criterion: the tip curvature still changes sign in the last
+    drive period (the actuator follows the drive instead of staying collapsed)."""
+    k = r.tip_curvature[_last_period(r, point)]
+    return bool(k.max() > 0 > k.min())
+
+
+def metric_settling_time(r, point, scene) -> float:
+    """Time (s) after which the tip curvature stays within 2 % of its final change."""
+    k = r.tip_curvature
+    band = 0.02 * max(abs(k[-1] - k[0]), 1e-300)
+    outside = np.nonzero(np.abs(k - k[-1]) > band)[0]
+    return float(r.time[outside[-1] + 1]) if outside.size and outside[-1] + 1 < k.size else 0.0
+
+
+def metric_max_stress_proxy(r, point, scene) -> float:
+    """Outer-fibre bending stress proxy (Pa): max |tip curvature| x (thickness / 2) x the
+    stiffest layer's modulus (a uniform arc; not a stress analysis)."""
+    act = scene.actuator
+    e_max = max(layer.youngs_modulus for layer in act.layers)
+    return float(np.abs(r.tip_curvature).max() * 0.5 * act.thickness * e_max)
+
+
+def metric_max_tip_deflection(r, point, scene) -> float:
+    """Largest transverse tip deflection (m)."""
+    return float(np.abs(r.tip_position[:, 1]).max())
+
+
+METRICS: Dict[str, Callable] = {
+    "peak_to_peak": metric_peak_to_peak, "returns": metric_returns, "settling_time": metric_settling_time,
+    "max_stress_proxy": metric_max_stress_proxy, "max_tip_deflection": metric_max_tip_deflection,
+}
+
+
+def register_metric(name: str, fn: Callable) -> None:
+    """Add ``fn(result, point, scene) -> number`` as metric ``name`` (in every worker
+    process, register it at import time of a module the workers import)."""
+    METRICS[name] = fn
+
+
+# ---------------------------------------------------------------- designs
+def _check_names(names: Iterable[str]) -> None:
+    for n in names:
+        if n not in PARAMETERS and not n.startswith("drive."):
+            raise ParameterError("sweep parameter", n, f"one of {', '.join(PARAMETERS)} or drive.NAME")
+
+
+def grid(**values: Sequence) -> List[dict]:
+    """Full factorial design: every combination of the given values."""
+    _check_names(values)
+    names = list(values)
+    return [dict(zip(names, combo)) for combo in itertools.product(*(list(values[n]) for n in names))]
+
+
+def random_design(n: int, seed: int = 0, **ranges) -> List[dict]:
+    """``n`` points, each parameter drawn uniformly from a (low, high) range or a list of
+    choices, with numpy's generator seeded by ``seed``."""
+    _check_names(ranges)
+    if int(n) < 1:
+        raise ParameterError("n", n, "a positive number of points")
+    rng = np.random.default_rng(seed)
+    cols = {}
+    for k, v in ranges.items():
+        if isinstance(v, tuple) and len(v) == 2 and all(isinstance(x, (int, float)) for x in v):
+            cols[k] = rng.uniform(v[0], v[1], int(n)).tolist()
+        else:
+            choices = list(v)
+            cols[k] = [choices[i] for i in rng.integers(0, len(choices), int(n))]
+    return [{k: cols[k][i] for k in ranges} for i in range(int(n))]
+
+
+def point_id(point: dict) -> str:
+    """Stable key of a point: hash of its parameters (JSON, sorted keys)."""
+    return hashlib.sha1(json.dumps(point, sort_keys=True, default=float).encode()).hexdigest()[:12]
+
+
+# ---------------------------------------------------------------- one point
+def evaluate(point: dict, metrics: Sequence[str] = ("peak_to_peak", "returns"), base: Optional[dict] = None,
+             rrd_dir: Optional[str] = None) -> dict:
+    """Run one point (``base`` filled in under it) and return its row: the parameters, the
+    metrics, ``error`` (empty when it ran), ``wall_s`` and ``point_id``. Never raises for a
+    failing point."""
+    from .discretize import Payload
+    from .rollout import rollout
+    from .scene import Scene
+
+    p = {**PARAMETERS, **(base or {}), **point}
+    row = {"point_id": point_id(point), **point, "error": "", "wall_s": 0.0}
+    for m in metrics:
+        row[m] = ""
+    t0 = time.perf_counter()
+    try:
+        unknown = [m for m in metrics if m not in METRICS]
+        if unknown:
+            raise UnknownNameError("metric", unknown[0], METRICS)
+        payload = None
+        if p["payload_mass"]:
+            pos = p["payload_position"]
+            if pos is None:
+                raise ParameterError("payload_position", None, "a position in m when payload_mass > 0")
+            payload = Payload(float(p["payload_mass"]), float(pos))
+        scene = Scene(p["actuator"], representation=p["representation"], segments=int(p["segments"]),
+                      orientation=p["orientation"], payload=payload, damping_ratio=p["damping_ratio"])
+        f = float(p["frequency"])
+        duration = p["duration"] if p["duration"] is not None else 2.0 / f
+        kind = p["waveform"]
+        wave = f"step:{float(p['amplitude'])!r}V" if kind == "step" else \
+            f"{kind}:{float(p['amplitude'])!r}V@{f!r}Hz,offset={float(p['offset'])!r}V"
+        drive_params = {k[6:]: v for k, v in p.items() if k.startswith("drive.")}
+        rrd = None if rrd_dir is None else Path(rrd_dir) / f"point-{row['point_id']}.rrd"
+        r = rollout(scene, wave, float(duration), drive_params=drive_params, initial_curvature=float(p["initial_curvature"]),
+                    progress=False, rrd=rrd)
+        for m in metrics:
+            row[m] = METRICS[m](r, p, scene)
+    except MjeapError as e:
+        row["error"] = f"{type(e).__name__}: {e}"
+        if "returns" in metrics and "diverged" in str(e):
+            row["returns"] = False
+    except Exception as e:  # a bug or a library error: keep the sweep going, keep the trace
+        row["error"] = f"{type(e).__name__}: {e} | {traceback.format_exc(limit=3)!r}"
+    row["wall_s"] = time.perf_counter() - t0
+    return row
+
+
+# ---------------------------------------------------------------- many points
+@dataclass
+class SweepSummary:
+    path: Path
+    done: int
+    skipped: int
+    failed: int
+    wall_s: float
+
+    @property
+    def throughput(self) -> float:
+        """Rollouts per second of wall time (points run in this call)."""
+        return self.done / self.wall_s if self.wall_s > 0 else float("nan")
+
+
+def read_results(path) -> List[dict]:
+    """Rows of a sweep CSV (strings; the header names the columns)."""
+    with open(path, newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def _submit_all(executor: str, workers: int, scheduler: Optional[str], jobs):
+    """Yield finished rows as they complete."""
+    if executor == "serial":
+        for args in jobs:
+            yield evaluate(*args)
+        return
+    if executor == "processes":
+        from concurrent.futures import ProcessPoolExecutor, as_completed
+        import multiprocessing as mp
+        # fork where there is one (fast start, works from any __main__), spawn elsewhere
+        ctx = mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn")
+        with ProcessPoolExecutor(max_workers=workers, mp_context=ctx) as pool:
+            futures = [pool.submit(evaluate, *args) for args in jobs]
+            for fut in as_completed(futures):
+                yield fut.result()
+        return
+    if executor == "dask":
+        try:
+            from distributed import Client, LocalCluster, as_completed
+        except ImportError:
+            raise ParameterError("executor", "dask", "an installed Dask: pip install -e '.[sweep]'") from None
+        cluster = None
+        if scheduler:
+            client = Client(scheduler)
+        else:
+            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                   dashboard_address=None)
+            client = Client(cluster)
+        try:
+            futures = [client.submit(evaluate, *args, pure=False) for args in jobs]
+            for fut in as_completed(futures):
+                yield fut.result()
+        finally:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+        return
+    raise ParameterError("executor", executor, "one of serial, processes, dask")
+
+
+def run_sweep(points: Sequence[dict], path, metrics: Sequence[str] = ("peak_to_peak", "returns"),
+              base: Optional[dict] = None, executor: str = "processes", workers: int = 2,
+              scheduler: Optional[str] = None, record: Sequence[int] = (), rrd_dir=None,
+              progress: bool = True) -> SweepSummary:
+    """Evaluate ``points`` and stream one CSV row per finished point to ``path``. Points
+    already in the file (same ``point_id``) are skipped. ``record``: indices of points
+    that also write a recording to ``rrd_dir`` (default: next to the CSV)."""
+    path = Path(path)
+    if executor not in ("serial", "processes", "dask"):
+        raise ParameterError("executor", executor, "one of serial, processes, dask")
+    if int(workers) < 1:
+        raise ParameterError("workers", workers, "a positive number of worker processes")
+    unknown = [m for m in metrics if m not in METRICS]
+    if unknown:
+        raise UnknownNameError("metric", unknown[0], METRICS)
+    points = list(points)
+    for p in points:
+        _check_names(p)
+    done_ids = set()
+    if path.exists() and path.stat().st_size > 0:
+        done_ids = {row["point_id"] for row in read_results(path)}
+    rrd_dir = str(rrd_dir or path.parent / (path.stem + "-rrd"))
+    record = set(int(i) for i in record)
+    jobs = [(p, tuple(metrics), base, rrd_dir if i in record else None) for i, p in enumerate(points)
+            if point_id(p) not in done_ids]
+    skipped = len(points) - len(jobs)
+    columns = ["point_id", *sorted({k for p in points for k in p}), *metrics, "error", "wall_s"]
+    path.parent.mkdir(parents=True, exist_ok=True)
+    new_file = not path.exists() or path.stat().st_size == 0
+    if not new_file:
+        with open(path, newline="") as fh:
+            header = next(csv.reader(fh))
+        if header != columns:
+            raise ParameterError("path", str(path), f"a CSV of this sweep (columns {columns}); it has {header}")
+    bar = None
+    if progress:
+        try:
+            from tqdm import tqdm
+            bar = tqdm(total=len(jobs), unit="point", desc="sweep")
+        except ImportError:  # pragma: no cover
+            bar = None
+    failed, done = 0, 0
+    t0 = time.perf_counter()
+    with open(path, "a", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=columns)
+        if new_file:
+            w.writeheader()
+            fh.flush()
+        try:
+            for row in _submit_all(executor, int(workers), scheduler, jobs):
+                w.writerow({k: row.get(k, "") for k in columns})
+                fh.flush()
+                os.fsync(fh.fileno())
+                done += 1
+                failed += bool(row["error"])
+                if bar is not None:
+                    bar.update(1)
+        finally:
+            if bar is not None:
+                bar.close()
+    return SweepSummary(path, done, skipped, failed, time.perf_counter() - t0)
