@@ -30,6 +30,7 @@ from scipy import optimize
 from mjeap import Scene, rollout
 from mjeap.calibration import calibrate_tip_extension
 from mjeap.discretize import Payload
+from mjeap.drives import make_drive
 from mjeap.errors import ParameterError, check_positive
 from mjeap.frequency import phasor, sine_sweep
 
@@ -73,9 +74,9 @@ def leg_scene(transmission: Transmission, actuator=None, **scene_kw) -> Scene:
     def scene(mass):
         return Scene(act, gravity=False, payload=Payload(mass, tip, radius=1e-5), **scene_kw)
 
-    # one-mode guess: f^2 proportional to 1 / (m + m_eff) with m_eff from the free beam
-    k_over = (2 * np.pi * f_free) ** 2
-    guess = k_over * 1e-6 / (2 * np.pi * transmission.resonance) ** 2   # kg per 1 mg of effective mass
+    # one-mode guess, f^2 ~ k / (m + m_eff), with an effective beam mass of 1 mg; the
+    # bracket spans four decades around it
+    guess = 1e-6 * (f_free / transmission.resonance) ** 2
     mass = optimize.brentq(lambda m: scene(m).choice.first_frequency - transmission.resonance,
                            guess * 1e-2, guess * 1e4, xtol=1e-12, rtol=1e-6)
     return scene(mass)
@@ -180,7 +181,8 @@ def run_leg(transmission: Transmission = SWING, cycles: int = 40, open_loop_cycl
     act = free_actuator()
     if estimator is None:
         free = Scene(act, gravity=False)
-        c_fit = 8e-9 * 32.2 / 32.2       # the drive's estimate for Type II; a user's measured value
+        # the drive's own capacitance stands in for a user's fixed-actuator measurement
+        c_fit = make_drive("piezo-bimorph", free, bias=bias).params["capacitance"]
         sweep = sine_sweep(free, (100.0, 1000.0, 1500.0, 1750.0, 2000.0), bias / 2, bias / 4,
                            drive_params={"bias": bias})
         estimator = calibrate(sweep, bias, 1e9, c_fit)

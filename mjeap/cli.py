@@ -289,7 +289,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--metrics", default="peak_to_peak,returns",
                    help="comma list: peak_to_peak, returns, settling_time, max_stress_proxy, max_tip_deflection")
     p.add_argument("--out", default="out/sweep.csv", help="results CSV (appended; finished points are skipped)")
-    p.add_argument("--executor", choices=["processes", "serial", "dask"], default="processes")
+    from .sweep import EXECUTORS
+    p.add_argument("--executor", choices=EXECUTORS, default="processes")
     p.add_argument("--workers", type=int, default=2, help="worker processes (local pool or Dask LocalCluster)")
     p.add_argument("--scheduler", help="Dask scheduler address (tcp://host:8786); default: a LocalCluster")
     p.add_argument("--record", help="comma list of point indices that also write a .rrd")

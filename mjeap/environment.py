@@ -110,7 +110,7 @@ class CurvatureTrackingTask(base.Task):
             sc.set_hinge_angles(np.full(sc.layout.segments, kappa0 * sc.layout.ds))
         sc._step_count = 0
         physics.drive.reset(kappa0)
-        physics.voltage = 0.5 * sum(physics.drive.voltage_range()) if physics.drive.name == "piezo-bimorph" else 0.0
+        physics.voltage = physics.drive.rest_voltage()
         self.saturated_steps, self._warned = 0, False
         self._signal_names = list(physics.drive.signals())
 
@@ -191,7 +191,7 @@ def run_episode(env: control.Environment, policy: Callable, rrd=None):
     sc = physics.scene
     rows, error = [], None
 
-    def sample(ts, action):
+    def sample(ts):
         p = sc.tip_position()
         sig = dict(physics.drive.signals())
         sig["reward (-)"] = np.nan if ts.reward is None else float(ts.reward)
@@ -201,11 +201,11 @@ def run_episode(env: control.Environment, policy: Callable, rrd=None):
 
     try:
         ts = env.reset()
-        sample(ts, None)
+        sample(ts)
         while not ts.last():
             action = policy(ts)
             ts = env.step(action)
-            sample(ts, action)
+            sample(ts)
     except BaseException as e:
         error = e
         raise

@@ -31,7 +31,7 @@ from . import analytical
 from .catalog import Actuator, get_actuator
 from .discretize import BeamLayout, Payload, check_payload, clamp_rotation, discretize
 from .errors import DivergenceError, ParameterError, check_positive, check_range
-from .mjcf import BeamHandles, build_spec, get_builder
+from .mjcf import build_spec, get_builder
 from .modes import linearize, modal_frequencies, stability_limit
 from .units import DEFAULT_UNITS, UnitSystem
 

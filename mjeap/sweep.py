@@ -28,7 +28,9 @@ from typing import Callable, Dict, Iterable, List, Optional, Sequence
 
 import numpy as np
 
-from .errors import MjeapError, ParameterError, UnknownNameError
+from .errors import DivergenceError, MjeapError, ParameterError, UnknownNameError
+
+EXECUTORS = ("processes", "serial", "dask")
 
 #: point parameters and their defaults (SI); ``drive.NAME`` entries go to the drive
 PARAMETERS: Dict[str, object] = {
@@ -167,7 +169,7 @@ def evaluate(point: dict, metrics: Sequence[str] = ("peak_to_peak", "returns"), 
             row[m] = METRICS[m](r, p, scene)
     except MjeapError as e:
         row["error"] = f"{type(e).__name__}: {e}"
-        if "returns" in metrics and "diverged" in str(e):
+        if "returns" in metrics and isinstance(e, DivergenceError):
             row["returns"] = False
     except Exception as e:  # a bug or a library error: keep the sweep going, keep the trace
         row["error"] = f"{type(e).__name__}: {e} | {traceback.format_exc(limit=3)!r}"
@@ -212,7 +214,7 @@ def _submit_all(executor: str, workers: int, scheduler: Optional[str], jobs):
             for fut in as_completed(futures):
                 yield fut.result()
         return
-    if executor == "dask":
+    if executor == "dask":  # run_sweep has checked the name
         try:
             from distributed import Client, LocalCluster, as_completed
         except ImportError:
@@ -232,8 +234,6 @@ def _submit_all(executor: str, workers: int, scheduler: Optional[str], jobs):
             client.close()
             if cluster is not None:
                 cluster.close()
-        return
-    raise ParameterError("executor", executor, "one of serial, processes, dask")
 
 
 def run_sweep(points: Sequence[dict], path, metrics: Sequence[str] = ("peak_to_peak", "returns"),
@@ -244,8 +244,8 @@ def run_sweep(points: Sequence[dict], path, metrics: Sequence[str] = ("peak_to_p
     already in the file (same ``point_id``) are skipped. ``record``: indices of points
     that also write a recording to ``rrd_dir`` (default: next to the CSV)."""
     path = Path(path)
-    if executor not in ("serial", "processes", "dask"):
-        raise ParameterError("executor", executor, "one of serial, processes, dask")
+    if executor not in EXECUTORS:
+        raise ParameterError("executor", executor, f"one of {', '.join(EXECUTORS)}")
     if int(workers) < 1:
         raise ParameterError("workers", workers, "a positive number of worker processes")
     unknown = [m for m in metrics if m not in METRICS]

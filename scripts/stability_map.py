@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from mjeap import analytical as an
-from mjeap.sweep import grid, read_results, run_sweep
+from mjeap.sweep import EXECUTORS, grid, read_results, run_sweep
 
 L_E = 6.27e-3          # m, seed 000's payload position
 L = 6e-3
@@ -34,7 +34,7 @@ def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", default="out/stability")
     ap.add_argument("--workers", type=int, default=2)
-    ap.add_argument("--executor", default="processes", choices=["processes", "serial", "dask"])
+    ap.add_argument("--executor", default="processes", choices=EXECUTORS)
     ap.add_argument("--masses", type=int, default=11, help="payload masses from 0 to 150 mg")
     ap.add_argument("--amplitudes", type=int, default=6, help="amplitudes from 0.25 to 1.5 V")
     a = ap.parse_args(argv)

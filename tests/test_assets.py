@@ -1,6 +1,5 @@
 """assets/mjcf is up to date, and every model compiles and stays at rest when unforced."""
 import mujoco
-import numpy as np
 import pytest
 
 from mjeap import DEFAULT_UNITS, analytical as an, get_actuator, load_mjcf

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from mjeap import Scene, analytical as an, rollout
+from mjeap import Scene, rollout
 from mjeap.catalog import PVDF_60
 from mjeap.drives import make_drive
 from mjeap.drives.electrostrictive import maxwell_stress_model

@@ -122,6 +122,10 @@ class Drive:
     def voltage_range(self) -> Tuple[float, float]:
         return tuple(self.scene.actuator.voltage_range)
 
+    def rest_voltage(self) -> float:
+        """The input (V) at which the drive applies no moment: where a run at rest starts."""
+        return 0.0
+
     def check_voltage(self, v: np.ndarray) -> None:
         lo, hi = self.voltage_range()
         v = np.asarray(v)

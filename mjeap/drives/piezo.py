@@ -62,9 +62,13 @@ class PiezoBimorphDrive(Drive):
     def voltage_range(self):
         return (0.0, float(self.params["bias"]))
 
+    def rest_voltage(self) -> float:
+        """V_sig = V_bias / 2: both plates see the same field, V_eff = 0."""
+        return 0.5 * self.params["bias"]
+
     def reset(self, initial_curvature: float = 0.0) -> None:
         self._v_prev = None
-        self._v = 0.5 * self.params["bias"]
+        self._v = self.rest_voltage()
         self._dv = 0.0
         self.scene.set_internal_moments(0.0)
         self._m = np.zeros(self.scene.layout.segments)
