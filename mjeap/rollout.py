@@ -124,17 +124,22 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
         # the voltage held over the step that ended at this sample (the first sample: the
         # first step's), the same convention as the drive signals read now
         out_v[i] = v_hold if controller is not None else v_steps[max(step - 1, 0)]
-        tip[i] = scene.tip_position()
+        cl[i] = scene.centreline()
+        tip[i] = cl[i, -1]                      # the centreline ends at the tip point
         ang[i] = scene.tip_angle()
         kap[i] = arc_curvature(tip[i, 0], tip[i, 1])
-        cl[i] = scene.centreline()
         if pay is not None:
             pay[i] = scene.payload_position()
         for k, v in drv.signals().items():
-            sig.setdefault(k, np.full(ns, np.nan))[i] = v
+            if k not in sig:
+                sig[k] = np.full(ns, np.nan)
+            sig[k][i] = v
         if controller is not None and hasattr(controller, "signals"):
             for k, v in controller.signals().items():
-                sig.setdefault(f"controller_{k}", np.full(ns, np.nan))[i] = v
+                k = f"controller_{k}"
+                if k not in sig:
+                    sig[k] = np.full(ns, np.nan)
+                sig[k][i] = v
 
     meta = {"actuator": scene.actuator.id, "drive": drv.describe(), "voltage": "closed loop" if wave is None else getattr(wave, "text", str(wave)),
             "duration_s": duration, "initial_curvature_per_m": initial_curvature, "steps": n_steps,

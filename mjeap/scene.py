@@ -149,8 +149,9 @@ class Scene:
         self.spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_AUTORESET
         self.choice = self._choose_timestep_and_damping(zeta, timestep)
         self.model = apply_dof_damping(self.spec.compile())
-        self.data = mujoco.MjData(self.model)
+        self._data = mujoco.MjData(self.model)
         self._ids()
+        self._bind_views()
         self._tip_force_world = np.zeros(3)
         self._tip_moment = 0.0
         self.reset()
@@ -243,12 +244,45 @@ class Scene:
         # the same as slices (views, no copies) when evenly spaced, for the per-step paths
         self._bend_sl = _as_slice(self.bend_dof)
         self._qpos_sl = _as_slice(self.joint_qpos) if self.representation == "hinge" else None
+        # a ball joint's bending angle is 2 atan2(q_z, q_w) of its quaternion
+        self._quat_sl = None if self.representation == "hinge" else \
+            (_as_slice(self.joint_qpos), _as_slice(self.joint_qpos + 3))
         self._inv_moment = 1.0 / self.units.moment
         self._k_bend = self.layout.hinge_stiffness / self.units.rotational_stiffness  # internal units
         self._d0 = m.dof_damping.copy()
+        # model views of the bending stiffness and damping, for per-step changes (drives
+        # whose stiffness follows the field) without allocation; None if not strided
+        jsl = _as_slice(self.joint_ids)
+        self._jnt_stiffness_bend = m.jnt_stiffness[jsl] \
+            if isinstance(jsl, slice) and self.representation == "hinge" else None
+        self._dof_damping_bend = m.dof_damping[self._bend_sl] if isinstance(self._bend_sl, slice) else None
+        self._d0_bend = self._d0[self._bend_sl]
         self._stiffness_scale = 1.0
         # offset from the tip body's centre of mass to the tip site, body frame
         self._tip_offset = m.site_pos[self.tip_site_id] - m.body_ipos[self.tip_body_id]
+
+    @property
+    def data(self) -> mujoco.MjData:
+        """The scene's MjData (internal units)."""
+        return self._data
+
+    @data.setter
+    def data(self, data: mujoco.MjData) -> None:
+        # a dm_control Physics hands its own MjData to the scene; the views follow it
+        self._data = data
+        self._bind_views()
+
+    def _bind_views(self) -> None:
+        """Views (no copies) of the bending dofs in qpos, qvel and qfrc_applied, made once,
+        so the per-step paths of the drives allocate nothing; None where the dofs are not
+        evenly spaced (the indexed fallback then copies)."""
+        d, sl = self._data, self._bend_sl
+        strided = isinstance(sl, slice)
+        self._qfrc_bend = d.qfrc_applied[sl] if strided else None
+        self._qvel_bend = d.qvel[sl] if strided else None
+        self._qpos_bend = d.qpos[self._qpos_sl] if isinstance(self._qpos_sl, slice) else None
+        self._quat_wz = tuple(d.qpos[q] for q in self._quat_sl) \
+            if self._quat_sl is not None and all(isinstance(q, slice) for q in self._quat_sl) else None
 
     # ------------------------------------------------------------------ state
     @property
@@ -280,12 +314,25 @@ class Scene:
         self.data.qvel[:] = 0
         mujoco.mj_forward(self.model, self.data)
 
-    def hinge_angles(self) -> np.ndarray:
-        """Bending angle (rad) of every hinge about the hinge axis."""
+    def hinge_angles(self, out: Optional[np.ndarray] = None) -> np.ndarray:
+        """Bending angle (rad) of every hinge about the hinge axis; written into ``out``
+        (shape (segments,)) when given, which then allocates nothing."""
+        if self._qpos_bend is not None:            # hinge chain
+            if out is None:
+                return self._qpos_bend.copy()
+            np.copyto(out, self._qpos_bend)
+            return out
+        if self._quat_wz is not None:              # cable: 2 atan2(q_z, q_w)
+            a = np.arctan2(self._quat_wz[1], self._quat_wz[0], out=out)
+            a *= 2.0
+            return a
         q = self.data.qpos
-        if self._qpos_sl is not None:
-            return q[self._qpos_sl].copy()
-        return 2 * np.arctan2(q[self.joint_qpos + 3], q[self.joint_qpos])
+        a = q[self.joint_qpos].copy() if self.representation == "hinge" else \
+            2 * np.arctan2(q[self.joint_qpos + 3], q[self.joint_qpos])
+        if out is None:
+            return a
+        np.copyto(out, a)
+        return out
 
     # ------------------------------------------------------------------ loads
     def set_tip_force(self, force: Union[float, Sequence[float]]) -> None:
@@ -321,23 +368,35 @@ class Scene:
         """Internal bending moment (N m) at every hinge (scalar: the same everywhere), applied
         as equal and opposite couples on the two links it joins, i.e. a generalised force
         on the hinge's bending dof. Replaces the previous call's moments."""
-        M = np.multiply(moments, self._inv_moment)
         if self._stiffness_scale != 1.0 and self.representation != "hinge":
             # the cable plugin's stiffness is fixed at init: add the change as a moment
+            M = np.multiply(moments, self._inv_moment)
             M = M - (self._stiffness_scale - 1.0) * self._k_bend * self.hinge_angles()
-        self.data.qfrc_applied[self._bend_sl] = M
+            self.data.qfrc_applied[self._bend_sl] = M
+        elif self._qfrc_bend is not None:   # the per-step path: no allocation
+            if isinstance(moments, np.ndarray) and moments.ndim:
+                np.multiply(moments, self._inv_moment, out=self._qfrc_bend)
+            else:
+                self._qfrc_bend.fill(float(moments) * self._inv_moment)
+        else:
+            self.data.qfrc_applied[self._bend_sl] = np.multiply(moments, self._inv_moment)
 
     def set_bending_stiffness_scale(self, factor: float) -> None:
         """Scale every hinge's bending stiffness (and its Rayleigh damping, which keeps the
         stability limit) by ``factor`` relative to the catalog beam, e.g. for
         field-stiffened polymers."""
-        f = check_positive("stiffness factor", factor)
-        if f == self._stiffness_scale:
+        if factor == self._stiffness_scale:   # the per-step call of a drive: nothing to do
             return
+        f = check_positive("stiffness factor", factor)
         self._stiffness_scale = f
-        if self.representation == "hinge":
+        if self._jnt_stiffness_bend is not None:
+            np.multiply(self._k_bend, f, out=self._jnt_stiffness_bend)
+        elif self.representation == "hinge":
             self.model.jnt_stiffness[self.joint_ids] = self._k_bend * f
-        self.model.dof_damping[self.bend_dof] = self._d0[self.bend_dof] * f
+        if self._dof_damping_bend is not None:
+            np.multiply(self._d0_bend, f, out=self._dof_damping_bend)
+        else:
+            self.model.dof_damping[self.bend_dof] = self._d0[self.bend_dof] * f
 
     def set_hinge_parameters(self, stiffness=None, damping=None) -> None:
         """Set every hinge's bending stiffness (N m / rad) and/or viscous damping (N m s / rad),
@@ -366,9 +425,10 @@ class Scene:
         """Current viscous damping of every hinge's bending dof (N m s / rad)."""
         return self.model.dof_damping[self.bend_dof] * self.units.rotational_damping
 
-    def hinge_rates(self) -> np.ndarray:
-        """Bending angular velocity of every hinge (rad/s)."""
-        return self.data.qvel[self._bend_sl] / self.units.time
+    def hinge_rates(self, out: Optional[np.ndarray] = None) -> np.ndarray:
+        """Bending angular velocity of every hinge (rad/s); written into ``out`` when given."""
+        v = self._qvel_bend if self._qvel_bend is not None else self.data.qvel[self._bend_sl]
+        return np.multiply(v, 1.0 / self.units.time, out=out)
 
     def hinge_stiffness(self) -> np.ndarray:
         """Current bending stiffness of every hinge (N m / rad)."""

@@ -50,9 +50,18 @@ def make_drive(name: Optional[str], scene, **params) -> "Drive":
     return get_drive_class(name)(scene, **params)
 
 
+def zoh_first_order(pole: float, gain: float, dt: float) -> Tuple[float, float]:
+    """x' = -pole x + gain u stepped exactly over ``dt`` s with u held (zero-order hold,
+    scipy.signal.cont2discrete): returns (a, b) of x+ = a x + b u."""
+    one = np.ones((1, 1))
+    Ad, Bd, _, _, _ = signal.cont2discrete((-pole * one, gain * one, one, 0 * one), dt, method="zoh")
+    return float(Ad[0, 0]), float(Bd[0, 0])
+
+
 class ExactLTI:
     """A continuous linear system x' = A x + B u, y = C x + D u, stepped exactly for a
-    zero-order-hold input (scipy.signal.cont2discrete); vectorised over ``n`` copies."""
+    zero-order-hold input (scipy.signal.cont2discrete); vectorised over ``n`` copies.
+    ``advance`` works in place on preallocated arrays: a step allocates no array."""
 
     def __init__(self, A, B, C, D, dt: float, n: int = 1):
         Ad, Bd, Cd, Dd, _ = signal.cont2discrete((np.atleast_2d(A), np.atleast_2d(B).reshape(-1, 1),
@@ -60,19 +69,34 @@ class ExactLTI:
         self.Ad, self.Bd, self.Cd, self.Dd = Ad, Bd[:, 0], Cd, Dd[:, 0]
         self.x = np.zeros((n, Ad.shape[0]))
         self._first_order = Ad.shape == (1, 1)
+        self._AdT = np.ascontiguousarray(Ad.T)
+        self._next = np.empty_like(self.x)     # x A_d^T of the step being taken
+        self._bu = np.empty_like(self.x)       # the input's contribution, u B_d^T
         if self._first_order:  # x+ = a x + b u, elementwise over the copies
             self._a, self._b = float(Ad[0, 0]), float(Bd[0, 0])
+            self._x1 = self.x[:, 0]            # a view: writes through x[:] stay visible
+            self._bu1 = self._bu[:, 0]
 
     def output(self, u) -> np.ndarray:
         return self.x @ self.Cd.T[:, 0] + self.Dd[0] * np.asarray(u)
 
     def advance(self, u) -> None:
+        """One step with ``u`` held: a scalar for all copies or one value per copy."""
         if self._first_order:
-            x = self.x[:, 0]
-            x *= self._a
-            x += self._b * np.asarray(u, dtype=float)
+            x, bu = self._x1, self._bu1
+            if x.shape[0] == 1 and not isinstance(u, np.ndarray):   # one scalar state
+                x[0] = self._a * float(x[0]) + self._b * u           # (ufuncs on size-1 arrays allocate)
+                return
+            if isinstance(u, np.ndarray):
+                np.multiply(u, self._b, out=bu)
+            else:
+                bu.fill(self._b * u)
+            np.multiply(x, self._a, out=x)
+            np.add(x, bu, out=x)
             return
-        self.x = self.x @ self.Ad.T + np.multiply.outer(np.asarray(u, dtype=float), self.Bd).reshape(self.x.shape)
+        np.matmul(self.x, self._AdT, out=self._next)
+        np.multiply(np.reshape(u, (-1, 1)), self.Bd, out=self._bu)
+        np.add(self._next, self._bu, out=self.x)
 
 
 class Drive:

@@ -68,7 +68,7 @@ class BlockingForceDrive(Drive):
 
     def step(self, voltage: float, dt: float) -> None:
         self.scene.set_bending_stiffness_scale(self.stiffness(voltage))
-        self._moment = 2.0 / 3.0 * self.force.x[0, 0] * self.L
+        self._moment = 2.0 / 3.0 * float(self.force.x[0, 0]) * self.L
         self.scene.set_internal_moments(self._moment)
         self.force.advance(voltage)
 

@@ -82,6 +82,8 @@ class ElectrostrictiveDrive(Drive):
         slopes = SLOPES.get(act.id)
         self.factors = None if (slopes is None or not self.params["stiffening"]) else np.array(slopes) / slopes[0]
         self._E = self._M = 0.0
+        # both models are quadratic in V (Maxwell stress ~ E^2; eigenstrain ~ strain ~ E^2)
+        self._M_per_V2 = self.moment(1.0)
 
     def moment(self, voltage: float) -> float:
         act = self.scene.actuator
@@ -99,7 +101,7 @@ class ElectrostrictiveDrive(Drive):
     def step(self, voltage: float, dt: float) -> None:
         if voltage != self._v_last:  # the drive is static in V: recompute only on change
             self._E = voltage / self.t_active
-            self._M = self.moment(voltage)
+            self._M = self._M_per_V2 * voltage * voltage
             self._f = self.stiffness_factor(self._E)
             self._v_last = voltage
         self.scene.set_bending_stiffness_scale(self._f)

@@ -71,10 +71,10 @@ class PiezoBimorphDrive(Drive):
         self._v = self.rest_voltage()
         self._dv = 0.0
         self.scene.set_internal_moments(0.0)
-        self._m = np.zeros(self.scene.layout.segments)
+        self._m = np.zeros(self.scene.layout.segments)   # per-hinge moment, N m, written in place
 
     def step(self, voltage: float, dt: float) -> None:
-        self._m = self.gamma * (voltage - 0.5 * self.params["bias"])
+        np.multiply(self.gamma, voltage - 0.5 * self.params["bias"], out=self._m)
         self.scene.set_internal_moments(self._m)
         self._dv = 0.0 if self._v_prev is None else (voltage - self._v_prev) / dt
         self._v = self._v_prev = voltage

@@ -22,7 +22,7 @@ from typing import Dict
 import numpy as np
 from scipy import signal
 
-from .base import Drive, ExactLTI, register_drive
+from .base import Drive, register_drive, zoh_first_order
 
 _SRC = "Dadras et al. 2021 (seed 000), eq. 8 (identified from a 3 V step)"
 
@@ -45,41 +45,51 @@ class RCRelaxationDrive(Drive):
         p = self.params
         self.EI = float(scene.actuator.flexural_rigidity_at(0.0)[0])
         self.gamma = p["gain"] * self.EI / p["pole_electrical"]   # N m per volt of v_c
-        dt = scene.timestep
-        a = p["pole_electrical"]
-        self.elec = ExactLTI([[-a]], [a], [[1.0]], [0.0], dt)
-        z, pm = p["zero"], p["pole_mechanical"]
-        self.relax = ExactLTI([[-z]], [z - pm], [[1.0]], [0.0], dt, n=scene.layout.segments)
-        self._v = 0.0
+        # state s = (r_1 .. r_N, v_c): the relaxation angle of every hinge and the
+        # double-layer voltage, all first order and stepped exactly (zero-order hold) in
+        # one vectorised update s+ = a s + b u with input u = (theta_1 .. theta_N, V)
+        n, dt = scene.layout.segments, scene.timestep
+        z, pm, pe = p["zero"], p["pole_mechanical"], p["pole_electrical"]
+        a_r, b_r = zoh_first_order(z, z - pm, dt)
+        a_e, b_e = zoh_first_order(pe, pe, dt)
+        self._a = np.r_[np.full(n, a_r), a_e]
+        self._b = np.r_[np.full(n, b_r), b_e]
+        self._s, self._u, self._bu = np.zeros(n + 1), np.zeros(n + 1), np.empty(n + 1)
+        self._r, self._theta = self._s[:n], self._u[:n]      # views
+        self._m_relax, self._m_total = np.empty(n), np.empty(n)
+        self._v = self._m_drive = 0.0
 
     def reset(self, initial_curvature: float = 0.0) -> None:
         """Start at rest at the scene's current shape: the relaxation state holds it (zero
         elastic moment beyond what gravity needs), so a bent start decays on the mechanical
         pole alone, as the zero-input term of seed 000's eq. (7)."""
         sc = self.scene
-        theta = sc.hinge_angles()
         # equilibrium at rest: k (theta - r) = gravity moment on each hinge
-        self.relax.x[:, 0] = theta - sc.gravity_moments() / sc.hinge_stiffness()
-        self.elec.x[:] = 0.0
+        self._r[:] = sc.hinge_angles() - sc.gravity_moments() / sc.hinge_stiffness()
+        self._s[-1] = 0.0
         self._v = 0.0
         self._k = sc.hinge_stiffness()
         self._apply()
 
     def _apply(self):
-        sc = self.scene
-        self._m_drive = self.gamma * self.elec.x[0, 0]
-        self._m_relax = self._k * self.relax.x[:, 0]
-        sc.set_internal_moments(self._m_drive + self._m_relax)
+        """Moments over the coming step: k r (relaxation) + Gamma v_c (drive), N m."""
+        self._m_drive = self.gamma * float(self._s[-1])
+        np.multiply(self._k, self._r, out=self._m_relax)
+        np.add(self._m_relax, self._m_drive, out=self._m_total)
+        self.scene.set_internal_moments(self._m_total)
 
     def step(self, voltage: float, dt: float) -> None:
         self._v = voltage
         self._apply()
-        self.elec.advance(voltage)
-        self.relax.advance(self.scene.hinge_angles())
+        self.scene.hinge_angles(out=self._theta)
+        self._u[-1] = voltage
+        np.multiply(self._b, self._u, out=self._bu)
+        self._s *= self._a
+        self._s += self._bu
 
     def signals(self) -> Dict[str, float]:
         C = self.params["capacitance"]
-        vc = float(self.elec.x[0, 0])
+        vc = float(self._s[-1])
         return {"double_layer_voltage (V)": vc, "charge (C)": C * vc,
                 "current (A)": C * self.params["pole_electrical"] * (self._v - vc),
                 "drive_moment (N m)": float(self._m_drive),
