@@ -140,8 +140,9 @@ def cmd_rollout(args) -> int:
     params = _params(args.param)
     r = rollout(scene, args.voltage, args.duration, drive=args.drive, drive_params=params,
                 initial_curvature=args.initial_curvature, rrd=args.rrd, csv_path=args.csv,
-                progress=None if not args.quiet else False)
-    summary = {"actuator": scene.actuator.id, "drive": r.meta["drive"], "voltage": args.voltage,
+                progress=None if not args.quiet else False, engine=args.engine)
+    summary = {"actuator": scene.actuator.id, "drive": r.meta["drive"], "engine": r.meta["engine"],
+               "voltage": args.voltage,
                "duration_s": args.duration, "timestep_s": scene.timestep, "steps": r.meta["steps"],
                "wall_time_s": round(r.meta["wall_time_s"], 3),
                "tip_curvature_final_per_m": float(r.tip_curvature[-1]),
@@ -271,6 +272,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--initial-curvature", type=float, default=0.0, help="start as a uniform arc (1/m)")
     p.add_argument("--rrd", help="write a Rerun recording here")
     p.add_argument("--csv", help="write the time series here")
+    from .rollout import ENGINES
+    p.add_argument("--engine", choices=ENGINES, default="auto",
+                   help="'loop' (Python lockstep), 'threaded' (mujoco.rollout; open-loop drives only) or "
+                        "'auto' (threaded where it applies; default)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_rollout)
     p = sub.add_parser("validate", help="run the validation experiments; report, figures and recordings")

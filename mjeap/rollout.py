@@ -1,10 +1,19 @@
 """Headless rollouts: a scene, a drive and a voltage waveform, stepped in lockstep.
 
-Why an explicit loop and not MuJoCo's ``mjcb_control`` hook: the Python callback is one
-global per process (two scenes, or a scene and a dm_control environment, would fight over
-it) and it costs a C-to-Python call per step anyway. The loop below calls the drive, then
-``mj_step``, once per step; the drive's cost per step is reported by ``scripts/bench.py``.
-The waveform is evaluated for all steps up front (vectorised).
+Two engines give the same trajectory (tested to round-off):
+
+* ``loop``: the drive, then ``mj_step``, once per step from Python. It serves every drive
+  and closed-loop controllers. Why not MuJoCo's ``mjcb_control`` hook: that callback is
+  one global per process (two scenes, or a scene and a dm_control environment, would
+  fight over it) and costs a C-to-Python call per step anyway.
+* ``threaded``: MuJoCo's native ``mujoco.rollout`` (:mod:`mjeap.threaded`), no Python per
+  step, many rollouts over a thread pool. It applies where the drive is open-loop: its
+  moments follow from the voltage alone, so their whole history is computed up front
+  (piezo bimorph; blocking force without a stiffness table; electrostrictive without
+  field stiffening), there is no controller and no tip load.
+
+``engine="auto"`` (the default) takes ``threaded`` where it applies. The waveform is
+evaluated for all steps up front (vectorised).
 """
 from __future__ import annotations
 
@@ -12,13 +21,13 @@ import csv
 import time as _time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Dict, Optional, Union
+from typing import Dict, List, Optional, Sequence, Union
 
 import mujoco
 import numpy as np
 
 from .analytical import arc_curvature
-from .errors import DivergenceError, check_positive
+from .errors import DivergenceError, ParameterError, check_positive
 from .scene import Scene
 from .waveforms import Waveform, parse_waveform
 
@@ -31,6 +40,7 @@ except ImportError:  # pragma: no cover
 DEFAULT_SAMPLES = 5000
 #: runs of more steps than this show a progress bar (when progress is None)
 PROGRESS_STEPS = 200_000
+ENGINES = ("auto", "loop", "threaded")
 
 
 @dataclass
@@ -71,11 +81,97 @@ class RolloutResult:
             w.writerows(np.column_stack([np.asarray(c, dtype=float) for c in cols.values()]))
 
 
+class _Samples:
+    """Preallocated sample arrays of one rollout, filled from the scene's present state
+    (kinematics up to date) and the drive's signals."""
+
+    def __init__(self, scene: Scene, ns: int):
+        self.scene, self.ns = scene, ns
+        N = scene.layout.segments
+        self.t, self.v = np.empty(ns), np.empty(ns)
+        self.tip, self.ang, self.kap = np.empty((ns, 3)), np.empty(ns), np.empty(ns)
+        self.cl = np.empty((ns, N + 2, 3))
+        self.pay = np.empty((ns, 3)) if scene.payload is not None else None
+        self.sig: Dict[str, np.ndarray] = {}
+        self.n = 0                                  # samples taken
+
+    def _put(self, key, i, value):
+        if key not in self.sig:
+            self.sig[key] = np.full(self.ns, np.nan)
+        self.sig[key][i] = value
+
+    def take(self, t: float, v: float, drive, controller=None) -> None:
+        """Sample the state after the step that ended at ``t`` s, ``v`` the voltage held over
+        that step (the first sample: the first step's), the instant the drive signals describe."""
+        sc, i = self.scene, self.n
+        self.t[i], self.v[i] = t, v
+        self.cl[i] = sc.centreline()
+        self.tip[i] = self.cl[i, -1]                # the centreline ends at the tip point
+        self.ang[i] = sc.tip_angle()
+        self.kap[i] = arc_curvature(self.tip[i, 0], self.tip[i, 1])
+        if self.pay is not None:
+            self.pay[i] = sc.payload_position()
+        for k, x in drive.signals().items():
+            self._put(k, i, x)
+        if controller is not None and hasattr(controller, "signals"):
+            for k, x in controller.signals().items():
+                self._put(f"controller_{k}", i, x)
+        self.n += 1
+
+    def result(self, drive, initial_curvature: float, meta: dict) -> RolloutResult:
+        n = self.n
+        ref = drive.reference_curvature(self.t[:n], self.v[:n], initial_curvature) if n > 1 else None
+        return RolloutResult(self.t[:n], self.v[:n], self.tip[:n], self.ang[:n], self.kap[:n], self.cl[:n],
+                             None if self.pay is None else self.pay[:n],
+                             {k: x[:n] for k, x in self.sig.items()}, ref, meta)
+
+
+def _voltage_steps(wave, duration: float, dt: float, drive) -> np.ndarray:
+    n_steps = max(1, int(round(duration / dt)))
+    t_steps = np.arange(n_steps) * dt
+    v = np.zeros(n_steps) if wave is None else np.asarray(wave(t_steps), dtype=float) * np.ones(n_steps)
+    drive.check_voltage(v)
+    return v
+
+
+def _waveform(voltage, duration: float):
+    wave = parse_waveform(voltage) if isinstance(voltage, (str, Waveform)) else voltage
+    return wave.with_duration(duration) if isinstance(wave, Waveform) else wave
+
+
+def _sample_steps(n_steps: int, dt: float, sample_interval: Optional[float]) -> np.ndarray:
+    every = max(1, int(round(sample_interval / dt))) if sample_interval else max(1, n_steps // DEFAULT_SAMPLES)
+    return np.arange(0, n_steps + 1, every)
+
+
+def _meta(scene, drv, wave, duration, initial_curvature, n_steps, engine) -> dict:
+    return {"actuator": scene.actuator.id, "drive": drv.describe(),
+            "voltage": "closed loop" if wave is None else getattr(wave, "text", str(wave)),
+            "duration_s": duration, "initial_curvature_per_m": initial_curvature, "steps": n_steps,
+            "engine": engine, "scene": scene.summary(),
+            "drive_parameters": {k: [v, drv.sources.get(k, "")] for k, v in drv.params.items()}}
+
+
+def _choose_engine(engine: str, scene, drv, controller) -> str:
+    from . import threaded
+    if engine not in ENGINES:
+        raise ParameterError("engine", engine, f"one of {', '.join(ENGINES)}")
+    if engine == "loop":
+        return "loop"
+    why = threaded.why_not(scene, drv, controller)
+    if why is None:
+        return "threaded"
+    if engine == "threaded":
+        raise ParameterError("engine", "threaded", f"'loop' or 'auto' for this run: {why}")
+    return "loop"
+
+
 def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: float,
             drive: Union[str, "object", None] = None, drive_params: Optional[dict] = None,
             initial_curvature: float = 0.0, rrd: Union[str, Path, None] = None,
             csv_path: Union[str, Path, None] = None, sample_interval: Optional[float] = None,
-            progress: Optional[bool] = None, check_every: int = 100, controller=None) -> RolloutResult:
+            progress: Optional[bool] = None, check_every: int = 100, controller=None,
+            engine: str = "auto") -> RolloutResult:
     """Run ``scene`` driven by ``drive`` (name, instance or None for the actuator's own)
     with ``voltage`` (waveform text, :class:`Waveform` or callable v(t)) for ``duration`` s.
 
@@ -83,76 +179,72 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     arrays sampled every ``sample_interval`` s (default: at most 5000 samples). With
     ``rrd`` a Rerun recording is written (also when the run fails: it then ends with the
     error), with ``csv_path`` the time series as CSV. A diverging run raises
-    :class:`DivergenceError` naming the step, the drive and the timestep.
+    :class:`DivergenceError` naming the step, the drive and the timestep. ``engine``:
+    'loop', 'threaded' (open-loop drives only, see the module) or 'auto'.
     """
     from .drives import make_drive
-    from . import recording
+    from . import recording, threaded
 
     duration = check_positive("duration", duration, "s")
-    wave = None if controller is not None else \
-        parse_waveform(voltage) if isinstance(voltage, (str, Waveform)) else voltage
-    if isinstance(wave, Waveform):
-        wave = wave.with_duration(duration)
+    wave = None if controller is not None else _waveform(voltage, duration)
     drv = drive if (drive is not None and not isinstance(drive, str)) else \
         make_drive(drive, scene, **(drive_params or {}))
+    engine = _choose_engine(engine, scene, drv, controller)
     dt = scene.timestep
-    n_steps = max(1, int(round(duration / dt)))
-    t_steps = np.arange(n_steps) * dt
-    v_steps = np.zeros(n_steps) if wave is None else np.asarray(wave(t_steps), dtype=float) * np.ones(n_steps)
-    drv.check_voltage(v_steps)
-    every = max(1, int(round(sample_interval / dt))) if sample_interval else max(1, n_steps // DEFAULT_SAMPLES)
-    sample_steps = np.arange(0, n_steps + 1, every)
-    ns = len(sample_steps)
+    v_steps = _voltage_steps(wave, duration, dt, drv)
+    n_steps = len(v_steps)
+    sample_steps = _sample_steps(n_steps, dt, sample_interval)
+    samples = _Samples(scene, len(sample_steps))
+    meta = _meta(scene, drv, wave, duration, initial_curvature, n_steps, engine)
+    if controller is not None:
+        meta["controller"] = getattr(controller, "name", type(controller).__name__)
+    error = None
+    wall0 = _time.perf_counter()
+    try:
+        if engine == "threaded":
+            threaded.run(scene, [drv], [v_steps], [initial_curvature], sample_steps, [samples], nthread=0)
+        else:
+            _run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, progress, check_every,
+                      controller, meta)
+    except BaseException as e:  # record what was simulated, then re-raise
+        error = e
+        raise
+    finally:
+        meta["wall_time_s"] = _time.perf_counter() - wall0
+        result = samples.result(drv, initial_curvature, meta)
+        if error is not None:
+            meta["error"] = f"{type(error).__name__}: {error}"
+        if rrd is not None:
+            recording.write_recording(rrd, result, scene)
+        if csv_path is not None and samples.n > 0:
+            result.to_csv(csv_path)
+    return result
 
+
+def _run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, progress, check_every,
+              controller, meta) -> None:
+    """The lockstep engine: drive, then mj_step, once per step."""
+    dt, n_steps, ns = scene.timestep, len(v_steps), len(sample_steps)
     scene.reset(curvature=initial_curvature)
     drv.reset(initial_curvature)
     ctrl_every, v_lo, v_hi, saturated, v_hold = n_steps + 1, *drv.voltage_range(), 0, 0.0
     if controller is not None:
         controller.reset(scene, drv)
         ctrl_every = max(1, int(round(getattr(controller, "interval", dt) / dt)))
-        ctrl_name = getattr(controller, "name", type(controller).__name__)
-    N = scene.layout.segments
-    out_t, out_v = np.empty(ns), np.empty(ns)
-    tip, ang, kap = np.empty((ns, 3)), np.empty(ns), np.empty(ns)
-    cl = np.empty((ns, N + 2, 3))
-    pay = np.empty((ns, 3)) if scene.payload is not None else None
-    sig: Dict[str, np.ndarray] = {}
-
-    def sample(i, step):
-        scene.update_kinematics()
-        out_t[i] = step * dt
-        # the voltage held over the step that ended at this sample (the first sample: the
-        # first step's), the same convention as the drive signals read now
-        out_v[i] = v_hold if controller is not None else v_steps[max(step - 1, 0)]
-        cl[i] = scene.centreline()
-        tip[i] = cl[i, -1]                      # the centreline ends at the tip point
-        ang[i] = scene.tip_angle()
-        kap[i] = arc_curvature(tip[i, 0], tip[i, 1])
-        if pay is not None:
-            pay[i] = scene.payload_position()
-        for k, v in drv.signals().items():
-            if k not in sig:
-                sig[k] = np.full(ns, np.nan)
-            sig[k][i] = v
-        if controller is not None and hasattr(controller, "signals"):
-            for k, v in controller.signals().items():
-                k = f"controller_{k}"
-                if k not in sig:
-                    sig[k] = np.full(ns, np.nan)
-                sig[k][i] = v
-
-    meta = {"actuator": scene.actuator.id, "drive": drv.describe(), "voltage": "closed loop" if wave is None else getattr(wave, "text", str(wave)),
-            "duration_s": duration, "initial_curvature_per_m": initial_curvature, "steps": n_steps,
-            "scene": scene.summary(), "drive_parameters": {k: [v, drv.sources.get(k, "")] for k, v in drv.params.items()}}
+        ctrl_name = meta["controller"]
     show = (n_steps > PROGRESS_STEPS) if progress is None else progress
     bar = tqdm(total=n_steps, unit="step", desc=f"{scene.actuator.id} {drv.name}", disable=not show,
                leave=False) if tqdm else None
+    every = int(sample_steps[1] - sample_steps[0]) if ns > 1 else n_steps
     m, d = scene.model, scene.data
     step_fn = mujoco.mj_step
-    i_sample, error = 0, None
-    wall0 = _time.perf_counter()
+
+    def sample(step):
+        scene.update_kinematics()
+        samples.take(step * dt, v_hold if controller is not None else v_steps[max(step - 1, 0)], drv, controller)
+
     try:
-        sample(0, 0)
+        sample(0)
         i_sample = 1
         nxt = sample_steps[1] if ns > 1 else n_steps + 1
         for k in range(n_steps):
@@ -173,36 +265,53 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
                     who = f" Controller: {ctrl_name} (check its gains)." if controller is not None else ""
                     raise DivergenceError(f"{e} Drive: {drv.describe()}, voltage {v_steps[k]:.4g} V.{who}") from None
             if k + 1 == nxt:
-                sample(i_sample, k + 1)
+                sample(k + 1)
                 i_sample += 1
                 nxt = sample_steps[i_sample] if i_sample < ns else n_steps + 1
                 if bar is not None:
                     bar.update(every)
-    except BaseException as e:  # record what was simulated, then re-raise
-        error = e
-        raise
     finally:
         if bar is not None:
             bar.close()
-        meta["wall_time_s"] = _time.perf_counter() - wall0
         if controller is not None:
-            meta["controller"] = ctrl_name
             meta["saturated_updates"] = int(saturated)
             if saturated:
                 meta.setdefault("warnings", []).append(
                     f"{ctrl_name}: {saturated} voltage commands clipped to the safe range [{v_lo:g}, {v_hi:g}] V "
                     "(reference beyond reach or gains too high)")
-        n_ok = i_sample
-        ref = None
-        if n_ok > 1:
-            ref = drv.reference_curvature(out_t[:n_ok], out_v[:n_ok], initial_curvature)
-        result = RolloutResult(out_t[:n_ok], out_v[:n_ok], tip[:n_ok], ang[:n_ok], kap[:n_ok], cl[:n_ok],
-                               None if pay is None else pay[:n_ok], {k: v[:n_ok] for k, v in sig.items()},
-                               ref, meta)
-        if error is not None:
-            meta["error"] = f"{type(error).__name__}: {error}"
-        if rrd is not None:
-            recording.write_recording(rrd, result, scene)
-        if csv_path is not None and n_ok > 0:
-            result.to_csv(csv_path)
-    return result
+
+
+def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable]], duration: float,
+                  drive: Optional[str] = None, drive_params: Optional[dict] = None,
+                  initial_curvatures: Union[float, Sequence[float]] = 0.0,
+                  sample_interval: Optional[float] = None, nthread: Optional[int] = None) -> List[RolloutResult]:
+    """Many open-loop rollouts of one scene, one per entry of ``voltages`` (and of
+    ``initial_curvatures``, 1/m, a scalar for all), on MuJoCo's native threaded rollout
+    with ``nthread`` threads (default: one per CPU). Same results as :func:`rollout` run
+    one by one; raises ParameterError where the threaded path does not apply."""
+    import os
+    from .drives import make_drive
+    from . import threaded
+
+    duration = check_positive("duration", duration, "s")
+    voltages = list(voltages)
+    if not voltages:
+        raise ParameterError("voltages", voltages, "at least one waveform")
+    kappa0 = np.broadcast_to(np.asarray(initial_curvatures, dtype=float), (len(voltages),))
+    drives = [make_drive(drive, scene, **(drive_params or {})) for _ in voltages]
+    _choose_engine("threaded", scene, drives[0], None)
+    dt = scene.timestep
+    waves = [_waveform(v, duration) for v in voltages]
+    v_steps = [_voltage_steps(w, duration, dt, d) for w, d in zip(waves, drives)]
+    sample_steps = _sample_steps(len(v_steps[0]), dt, sample_interval)
+    samples = [_Samples(scene, len(sample_steps)) for _ in voltages]
+    nthread = (os.cpu_count() or 1) if nthread is None else int(nthread)
+    wall0 = _time.perf_counter()
+    threaded.run(scene, drives, v_steps, list(kappa0), sample_steps, samples, nthread=nthread)
+    wall = _time.perf_counter() - wall0
+    out = []
+    for w, d, k0, smp in zip(waves, drives, kappa0, samples):
+        meta = _meta(scene, d, w, duration, float(k0), len(v_steps[0]), "threaded")
+        meta.update(wall_time_s=wall, batch=len(voltages), nthread=nthread)
+        out.append(smp.result(d, float(k0), meta))
+    return out

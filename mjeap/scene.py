@@ -476,13 +476,18 @@ class Scene:
         bad = d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number > 0 or not np.all(np.isfinite(d.qpos)) \
             or not np.all(np.isfinite(d.qvel))
         if bad:
-            c = self.choice
-            raise DivergenceError(
-                f"{self.actuator.id} ({self.representation}) diverged by step {self._step_count} "
-                f"(t = {self.time:.6g} s): timestep {c.timestep:.4g} s, stability limit "
-                f"{c.stability_limit:.4g} s set by the highest bending mode ({c.highest_frequency:.4g} Hz) "
-                f"under {c.integrator}" + ("; the reference configuration is buckled under gravity"
-                                          if c.buckled else "") + ". Reduce the timestep or the load.")
+            raise self.divergence_error()
+
+    def divergence_error(self) -> DivergenceError:
+        """The error for a run that blew up by the present step: which scene, when, the
+        timestep against its stability limit and the mode that sets it."""
+        c = self.choice
+        return DivergenceError(
+            f"{self.actuator.id} ({self.representation}) diverged by step {self._step_count} "
+            f"(t = {self.time:.6g} s): timestep {c.timestep:.4g} s, stability limit "
+            f"{c.stability_limit:.4g} s set by the highest bending mode ({c.highest_frequency:.4g} Hz) "
+            f"under {c.integrator}" + ("; the reference configuration is buckled under gravity"
+                                      if c.buckled else "") + ". Reduce the timestep or the load.")
 
     def settle(self, tol: float = 1e-7, max_periods: int = 400) -> int:
         """Run to static equilibrium under the current loads with extra damping (first-mode

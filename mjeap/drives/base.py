@@ -160,5 +160,21 @@ class Drive:
                                  f"values in the safe range [{lo:g}, {hi:g}] V of {self.scene.actuator.id} "
                                  f"under {self.name}")
 
+    # -- open loop (MuJoCo's threaded rollout, mjeap.threaded) ---------------------------
+    def closed_loop_reason(self) -> Optional[str]:
+        """None where the moments follow from the voltage alone and the drive leaves the
+        model unchanged, so their history can be computed before the run; else why not."""
+        return "its moments depend on the beam's state (the drive does not declare itself open-loop)"
+
+    def open_loop_moments(self, v_steps: np.ndarray) -> np.ndarray:
+        """Bending moment (N m) at every hinge over every step from reset, (steps, segments),
+        for the voltages ``v_steps`` (V) held over the steps; afterwards :meth:`seek` works."""
+        raise NotImplementedError(f"{self.name}: {self.closed_loop_reason()}")
+
+    def seek(self, k: int) -> None:
+        """After :meth:`open_loop_moments`: put the drive in its state after ``k`` steps, so
+        that :meth:`signals` reads what the lockstep loop would (the scene holds the beam)."""
+        raise NotImplementedError(f"{self.name}: {self.closed_loop_reason()}")
+
     def describe(self) -> str:
         return f"{self.name} ({self.model_used})" if self.model_used else self.name

@@ -71,13 +71,30 @@ class PiezoBimorphDrive(Drive):
         self._v = self.rest_voltage()
         self._dv = 0.0
         self.scene.set_internal_moments(0.0)
-        self._m = np.zeros(self.scene.layout.segments)   # per-hinge moment, N m, written in place
+        self._m[:] = 0.0                        # per-hinge moment, N m, written in place
 
     def step(self, voltage: float, dt: float) -> None:
         np.multiply(self.gamma, voltage - 0.5 * self.params["bias"], out=self._m)
         self.scene.set_internal_moments(self._m)
         self._dv = 0.0 if self._v_prev is None else (voltage - self._v_prev) / dt
         self._v = self._v_prev = voltage
+
+    def closed_loop_reason(self):
+        return None
+
+    def open_loop_moments(self, v_steps):
+        self._hist = np.asarray(v_steps, dtype=float)
+        return np.multiply.outer(self._hist - 0.5 * self.params["bias"], self.gamma)
+
+    def seek(self, k: int) -> None:
+        v, dt = self._hist, self.scene.timestep
+        if k == 0:                              # as reset() leaves it
+            self._v, self._v_prev, self._dv = self.rest_voltage(), None, 0.0
+            self._m[:] = 0.0
+            return
+        self._v = self._v_prev = float(v[k - 1])
+        self._dv = 0.0 if k == 1 else (v[k - 1] - v[k - 2]) / dt
+        np.multiply(self.gamma, self._v - 0.5 * self.params["bias"], out=self._m)
 
     def currents(self):
         """(resistive, capacitive, motional) current of eq. (1), A, at the scene's present

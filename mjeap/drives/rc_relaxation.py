@@ -95,6 +95,9 @@ class RCRelaxationDrive(Drive):
                 "drive_moment (N m)": float(self._m_drive),
                 "relaxation_moment_mean (N m)": float(np.mean(self._m_relax))}
 
+    def closed_loop_reason(self):
+        return "the back-relaxation acts on every moment the beam carries, so the moments follow the hinge angles"
+
     def transfer_function(self) -> signal.TransferFunction:
         """Eq. (8): K(s)/V(s) in 1/(m V)."""
         p = self.params

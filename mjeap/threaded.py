@@ -1,0 +1,118 @@
+"""Open-loop rollouts on MuJoCo's native threaded rollout (``mujoco.rollout``).
+
+When it applies (:func:`why_not` says why not otherwise):
+
+* the drive is open-loop: its moments follow from the voltage alone and it leaves the
+  model unchanged (:meth:`Drive.closed_loop_reason` is None): the piezo bimorph, the
+  blocking-force drive without a stiffness table, the electrostrictive drive without field
+  stiffening. Seed 000's rc-relaxation drive is not: its back-relaxation acts on the
+  beam's own moments, a feedback on the hinge angles;
+* no controller (its voltage depends on the state) and no tip load set on the scene.
+
+How: the drive computes the moment history of the whole run up front
+(:meth:`Drive.open_loop_moments`, vectorised); it goes to ``mujoco.rollout`` as
+``qfrc_applied`` controls, in internal units, and the states come back for every step, in
+chunks that keep memory bounded. Steps run in C, many rollouts share a thread pool. The
+samples are read back by putting the sampled state into the scene's MjData
+(``mj_setState`` + ``mj_kinematics``) and the drive at that step (:meth:`Drive.seek`), so
+they are the lockstep loop's read-outs exactly.
+"""
+from __future__ import annotations
+
+from typing import List, Optional, Sequence
+
+import mujoco
+import numpy as np
+from mujoco import rollout as mj_rollout
+
+from .errors import DivergenceError
+
+STATE = mujoco.mjtState.mjSTATE_FULLPHYSICS
+CONTROL = mujoco.mjtState.mjSTATE_QFRC_APPLIED
+#: the state and control arrays of one chunk stay below this size
+CHUNK_BYTES = 64 * 2**20
+#: MuJoCo's mjMAXVAL: larger state entries count as diverged, as mj_checkPos/Vel do
+MAXVAL = 1e10
+
+
+def _error(scene, drive, voltage, b, B, note="") -> DivergenceError:
+    return DivergenceError(f"{note}{scene.divergence_error()} Drive: {drive.describe()}, voltage {voltage:.4g} V "
+                           f"(threaded rollout {b + 1} of {B}).")
+
+
+def why_not(scene, drive, controller=None) -> Optional[str]:
+    """None where the threaded engine applies to this run; else the reason, in words."""
+    if controller is not None:
+        return "a controller closes the loop (its voltage depends on the state)"
+    reason = drive.closed_loop_reason()
+    if reason is not None:
+        return f"the {drive.name} drive is not open-loop: {reason}"
+    if scene._tip_force_world.any() or scene._tip_moment:
+        return "a tip load is set on the scene (mujoco.rollout does not carry xfrc_applied)"
+    return None
+
+
+def run(scene, drives: Sequence, v_steps: Sequence[np.ndarray], initial_curvatures: Sequence[float],
+        sample_steps: np.ndarray, samples: Sequence, nthread: int = 0) -> None:
+    """Roll out ``len(drives)`` runs of ``scene`` (one drive, voltage history, initial
+    curvature and sample store each) with ``nthread`` threads (0: the calling thread),
+    filling the sample stores. Raises DivergenceError at the first non-finite state."""
+    m, d = scene.model, scene.data
+    B, n = len(drives), len(v_steps[0])
+    nstate, nv = mujoco.mj_stateSize(m, STATE), m.nv
+    dt, bend, scale = scene.timestep, scene.bend_dof, 1.0 / scene.units.moment
+    state0 = np.empty((B, nstate))
+    moments: List[np.ndarray] = []
+    for b in range(B):
+        scene.reset(curvature=initial_curvatures[b])
+        drives[b].reset(initial_curvatures[b])
+        mujoco.mj_getState(m, d, state0[b], STATE)
+        moments.append(drives[b].open_loop_moments(v_steps[b]) * scale)
+        drives[b].seek(0)
+        scene.update_kinematics()
+        samples[b].take(0.0, v_steps[b][0], drives[b])
+    chunk = int(max(1, min(n, CHUNK_BYTES // (8 * B * (nstate + nv)))))
+    datas = [mujoco.MjData(m) for _ in range(max(nthread, 1))]
+    control = np.zeros((B, chunk, nv))
+    i_next = 1                                      # next sample index (same for all runs)
+    with mj_rollout.Rollout(nthread=nthread) as pool:
+        for s0 in range(0, n, chunk):
+            c = min(chunk, n - s0)
+            for b in range(B):
+                control[b][:c, bend] = moments[b][s0:s0 + c]
+            state, _ = pool.rollout(m, datas, state0, control[:, :c], control_spec=CONTROL, nstep=c)
+            # a state is bad if not finite or beyond mjMAXVAL (internal units keep it near 1),
+            # or if it follows a step on which MuJoCo warned: the rollout then stops and
+            # repeats its last state, so time stops advancing there
+            finite = (np.abs(state[:, :, 1:]) < MAXVAL).all(axis=2)          # (B, c)
+            times = np.concatenate([state0[:, :1], state[:, :, 0]], axis=1)
+            frozen = np.diff(times, axis=1) <= 0
+            finite[:, :-1] &= ~frozen[:, 1:]
+            bad = int(np.argmin(finite.all(axis=0))) if not finite.all() else c
+            # samples up to the first bad step of any run
+            while i_next < len(sample_steps) and sample_steps[i_next] <= s0 + bad:
+                k = int(sample_steps[i_next])
+                for b in range(B):
+                    mujoco.mj_setState(m, d, state[b, k - s0 - 1], STATE)
+                    scene.update_kinematics()
+                    drives[b].seek(k)
+                    samples[b].take(k * dt, v_steps[b][k - 1], drives[b])
+                i_next += 1
+            if bad < c:
+                b = int(np.argmin(finite[:, bad]))
+                mujoco.mj_setState(m, d, state[b, bad], STATE)
+                scene._step_count = s0 + bad + 1
+                raise _error(scene, drives[b], v_steps[b][s0 + bad], b, B)
+            state0 = np.ascontiguousarray(state[:, c - 1])
+    if any(x.warning[mujoco.mjtWarning.mjWARN_BADQACC].number for x in datas):
+        # a warning on the very last step leaves no repeated state behind it
+        scene._step_count = n
+        raise _error(scene, drives[-1], v_steps[-1][-1], B - 1, B, "MuJoCo warned of a bad acceleration on the "
+                     "last step; ")
+    # leave the scene and the (last) drive as the lockstep loop does: final state, the
+    # moments of the last step still applied
+    mujoco.mj_setState(m, d, state0[-1], STATE)
+    d.qfrc_applied[bend] = moments[-1][-1]
+    drives[-1].seek(n)
+    scene._step_count = n
+    scene.update_kinematics()
