@@ -41,6 +41,9 @@ class BeamHandles:
     joints: List[str]                    # joint of hinge j
     tip_body: str
     tip_site: str = "tip"
+    #: massless body at the tip point: xfrc_applied acts at a body's centre of mass, so tip
+    #: loads go here and stay exact dead loads at the tip as the beam rotates
+    tip_load_body: str = "tip_load"
     clamp_body: str = "clamp"
     payload_body: Optional[str] = None
     extra: Dict[str, str] = field(default_factory=dict)
@@ -207,6 +210,7 @@ def build_spec(layout: BeamLayout, representation: str = "hinge", orientation: s
     tip = spec.body(handles.tip_body)
     tip_local = (layout.tip_x - layout.link_start[-1]) / units.length
     tip.add_site(name="tip", pos=[tip_local, 0, 0], size=[0.01 * L, 0, 0], rgba=[1, 0.3, 0.1, 1])
+    _set_inertial(tip.add_body(name=handles.tip_load_body, pos=[tip_local, 0, 0]), 0.0, [0, 0, 0], [0, 0, 0], units)
     if layout.extension_length > 0:
         x0 = (layout.length - layout.link_start[-1]) / units.length
         ext = tip.add_body(name="extension", pos=[x0, 0, 0])

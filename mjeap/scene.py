@@ -258,8 +258,7 @@ class Scene:
         self._dof_damping_bend = m.dof_damping[self._bend_sl] if isinstance(self._bend_sl, slice) else None
         self._d0_bend = self._d0[self._bend_sl]
         self._stiffness_scale = 1.0
-        # offset from the tip body's centre of mass to the tip site, body frame
-        self._tip_offset = m.site_pos[self.tip_site_id] - m.body_ipos[self.tip_body_id]
+        self.tip_load_id = body(h.tip_load_body)
 
     @property
     def data(self) -> mujoco.MjData:
@@ -271,6 +270,7 @@ class Scene:
         # a dm_control Physics hands its own MjData to the scene; the views follow it
         self._data = data
         self._bind_views()
+        self._apply_loads()
 
     def _bind_views(self) -> None:
         """Views (no copies) of the bending dofs in qpos, qvel and qfrc_applied, made once,
@@ -299,6 +299,7 @@ class Scene:
         """Reset to rest; ``curvature`` (1/m) starts the beam as a uniform arc of that
         curvature (seed 000 starts each experiment from a measured curvature)."""
         mujoco.mj_resetData(self.model, self.data)
+        self._apply_loads()                  # mj_resetData clears xfrc_applied; tip loads persist
         self.set_bending_stiffness_scale(1.0)
         if curvature:
             self.set_hinge_angles(np.full(self.layout.segments, curvature * self.layout.ds))
@@ -354,14 +355,11 @@ class Scene:
         self._apply_loads()
 
     def _apply_loads(self) -> None:
-        d, b = self.data, self.tip_body_id
-        f = self._tip_force_world
-        torque = self.rotation[:, 2] * self._tip_moment
-        if f.any():
-            arm = d.xmat[b].reshape(3, 3) @ self._tip_offset
-            torque = torque + np.cross(arm, f)
-        d.xfrc_applied[b, :3] = f
-        d.xfrc_applied[b, 3:] = torque
+        """Tip loads act on the massless tip-load body, whose centre of mass is the tip
+        point: constant in the world frame, they stay dead loads there as the beam moves."""
+        d, b = self.data, self.tip_load_id
+        d.xfrc_applied[b, :3] = self._tip_force_world
+        d.xfrc_applied[b, 3:] = self.rotation[:, 2] * self._tip_moment
 
     # ------------------------------------------------------------------ drives
     def set_internal_moments(self, moments) -> None:
@@ -449,13 +447,7 @@ class Scene:
     # ------------------------------------------------------------------ stepping
     def step(self, n: int = 1) -> None:
         """Advance ``n`` steps; raises :class:`DivergenceError` if the state blows up."""
-        m, d = self.model, self.data
-        if self._tip_force_world.any():
-            for _ in range(n):
-                self._apply_loads()
-                mujoco.mj_step(m, d)
-        else:
-            mujoco.mj_step(m, d, nstep=n)
+        mujoco.mj_step(self.model, self.data, nstep=n)
         self._step_count += n
         self.check_finite()
         self.update_kinematics()
