@@ -8,6 +8,20 @@ rollout: seed 000's heaviest experiment (pedot-micro, 12.6 mg at 6.27 mm, standi
 3 Vpp square wave at 0.1 Hz, 20 s) with the drive and the recording on: wall time and
 real-time factor, the drive's own cost per step, and the peak-to-peak tip curvature
 against a run at half the timestep and twice the segments.
+
+drives: cost of one drive step (us) for every drive on its actuator's 20-hinge beam.
+
+threaded: the lockstep loop against MuJoCo's native threaded rollout (open-loop piezo
+drive): one rollout, and a batch of 16 on 1 and 2 threads.
+
+elastica: the pedot-micro cantilever under a dead tip force with P L^2/EI = 1, damped
+(first-mode damping ratio 0.7 in both codes) and settled over 0.05 s simulated, in mjeap
+and in PyElastica 1.0 (optional, benchmark only: pip install -e ".[bench]"), with the tip
+error against the elastica (scipy solve_bvp) and the wall-time ratio; also with the
+drive callback running every step.
+
+sweep: rollouts per second of a 16-point sweep on 1 and 2 local worker processes, and the
+memory of one rollout.
 """
 import argparse
 import json
@@ -89,24 +103,264 @@ def bench_rollout(tmpdir):
             "fine": {"timestep_s": fine.timestep, "segments": fine.layout.segments}}
 
 
+def bench_drives(n=20000):
+    """Drive step cost (us), 20 hinges, the voltage alternating every step (worst case for
+    drives that cache on it)."""
+    from mjeap.drives import DRIVES, make_drive
+    rows = []
+    for name, cls in DRIVES.items():
+        s = Scene(cls.actuators[0])
+        drv = make_drive(name, s)
+        drv.reset(0.0)
+        lo, hi = drv.voltage_range()
+        v = (0.5 * (lo + hi) + 0.3 * (hi - lo), 0.5 * (lo + hi) + 0.2 * (hi - lo))
+        for k in range(100):
+            drv.step(v[k % 2], s.timestep)
+        t0 = time.perf_counter()
+        for k in range(n):
+            drv.step(v[k % 2], s.timestep)
+        rows.append({"drive": name, "actuator": s.actuator.id, "segments": s.layout.segments,
+                     "step_us": (time.perf_counter() - t0) / n * 1e6,
+                     "open_loop": drv.closed_loop_reason() is None})
+    return rows
+
+
+def bench_threaded():
+    """Loop vs mujoco.rollout on the HAMR bimorph (open-loop piezo drive), 0.2 s of a
+    100 V-biased sine, samples every 1 ms."""
+    from mjeap.rollout import rollout, rollout_batch
+    s = Scene("pzt-hamr-small")
+    volts = [f"sine:20V@{f:g}Hz,offset=100V" for f in np.linspace(100, 1000, 16)]
+    kw = dict(sample_interval=1e-3)
+    out = {"case": "pzt-hamr-small, 0.2 s, sine 20 V about 100 V, samples every 1 ms", "timestep_s": s.timestep}
+    for engine in ("loop", "threaded"):
+        t0 = time.perf_counter()
+        r = rollout(s, volts[0], 0.2, engine=engine, **kw)
+        out[f"single_{engine}_s"] = time.perf_counter() - t0
+    out["steps"] = r.meta["steps"]
+    t0 = time.perf_counter()
+    for v in volts:
+        rollout(s, v, 0.2, engine="loop", **kw)
+    out["batch16_loop_s"] = time.perf_counter() - t0
+    for nt in (1, 2):
+        t0 = time.perf_counter()
+        rollout_batch(s, volts, 0.2, nthread=nt, **kw)
+        out[f"batch16_threaded_{nt}thread_s"] = time.perf_counter() - t0
+    out["batch16_speedup_2threads_vs_loop"] = out["batch16_loop_s"] / out["batch16_threaded_2thread_s"]
+    return out
+
+
+# ------------------------------------------------------------------ elastica benchmark
+ELASTICA_ZETA = 0.7      # first-mode damping ratio in both codes: settled well within 0.05 s
+
+
+def _beam_numbers():
+    s = Scene("pedot-micro", gravity=False)
+    act = s.actuator
+    sec = act.section_at(0.0)
+    # the bending stiffness the scene simulates (plane-strain modulus of the wide strip)
+    L, w, t, EI = act.length, float(act.width_at(0.0)), sec.thickness, float(act.flexural_rigidity_at(0.0)[0])
+    return {"L": L, "w": w, "t": t, "EI": EI, "rho": act.layers[0].density, "E": EI / (w * t**3 / 12),
+            "f1": float(s.choice.first_frequency)}
+
+
+def _mjeap_cantilever(b, T, P, segments, drive=None, repeats=3):
+    """Best-of-``repeats`` wall time of T s simulated; tip at the end (m)."""
+    from mjeap import rollout
+    s = Scene("pedot-micro", gravity=False, damping_ratio=ELASTICA_ZETA, segments=segments)
+    s.set_tip_force(P)
+    best = np.inf
+    for _ in range(repeats):
+        s.reset()
+        t0 = time.perf_counter()
+        if drive is None:
+            s.run(T)
+        else:
+            rollout(s, "step:0V", T, drive=drive, sample_interval=T, engine="loop")
+        best = min(best, time.perf_counter() - t0)
+    tip = s.tip_position()
+    s.run(0.1 * T)
+    moved = float(np.linalg.norm(s.tip_position() - tip) / b["L"])
+    return {"segments": segments, "timestep_s": s.timestep, "steps": int(round(T / s.timestep)),
+            "integrator": s.integrator, "wall_s": best, "tip_m": tip[:2].tolist(),
+            "tip_moved_over_next_10pct_per_L": moved}
+
+
+def _pyelastica_cantilever(b, T, P, n, shifted):
+    """PyElastica 1.0 Cosserat rod of the same beam: rectangular section (bending and mass
+    second moments of the w x t strip; area equal), G = E/3 (nu = 1/2), clamp by
+    OneEndFixedBC, dead end force, AnalyticalLinearDamper with a uniform rate 2 zeta omega_1
+    (mass-proportional: first-mode damping ratio zeta). Timestep 0.9 x 2/omega_sr, the
+    Position-Verlet limit of the fastest mode, the shear-rotation of an element about the
+    thin axis, omega_sr^2 = alpha G A / (rho I_2) (independent of the element length).
+    ``shifted``: the rod starts half an element behind the clamp, so that the clamped first
+    element's centre sits at x = 0 (free length L)."""
+    import elastica as ea
+    L, w, t, E, rho = b["L"], b["w"], b["t"], b["E"], b["rho"]
+    G, A = E / 3.0, w * t
+    I0 = A * A / (4 * np.pi)                     # what straight_rod assumes (disk)
+    I1, I2, J = t * w**3 / 12, w * t**3 / 12, w * t**3 / 3
+    alpha = 4.0 / 3.0                            # PyElastica's shear coefficient
+    omega_sr = np.sqrt(alpha * G * A / (rho * I2))
+    dt = 0.9 * 2.0 / omega_sr
+
+    class Sim(ea.BaseSystemCollection, ea.Constraints, ea.Forcing, ea.Damping):
+        pass
+
+    def build():
+        sim = Sim()
+        length = L + (0.5 * L / (n - 0.5) if shifted else 0.0)
+        rod = ea.CosseratRod.straight_rod(n, np.array([L - length, 0.0, 0.0]), np.array([1.0, 0, 0]),
+                                          np.array([0, 1.0, 0]), length, np.sqrt(A / np.pi), rho,
+                                          youngs_modulus=E, shear_modulus=G)
+        # directors d1 = y (deflection), d2 = z (width), d3 = x: bending in the x-y plane is
+        # about d2, the thin axis
+        for k, (I, Idisk) in enumerate(((I1, I0), (I2, I0), (J, 2 * I0))):
+            rod.bend_matrix[k, k, :] *= I / Idisk
+        for k, (I, Idisk) in enumerate(((I1, I0), (I2, I0), (I1 + I2, 2 * I0))):
+            rod.mass_second_moment_of_inertia[k, k, :] *= I / Idisk
+        for i in range(n):
+            rod.inv_mass_second_moment_of_inertia[..., i] = np.linalg.inv(rod.mass_second_moment_of_inertia[..., i])
+        sim.append(rod)
+        sim.constrain(rod).using(ea.OneEndFixedBC, constrained_position_idx=(0,), constrained_director_idx=(0,))
+        sim.add_forcing_to(rod).using(ea.EndpointForces, np.zeros(3), np.array([0.0, P, 0.0]), ramp_up_time=1e-6)
+        sim.dampen(rod).using(ea.AnalyticalLinearDamper,
+                              uniform_damping_constant=2 * ELASTICA_ZETA * 2 * np.pi * b["f1"], time_step=dt)
+        sim.finalize()
+        return sim, rod
+
+    import logging
+    logging.getLogger().setLevel(logging.ERROR)  # its 'mass moment of inertia below tolerance' notice
+    sim, rod = build()                           # warm-up: numba compiles on the first steps
+    ea.integrate(ea.PositionVerlet(), sim, 200 * dt, 200, progress_bar=False)
+    sim, rod = build()
+    steps = int(round(T / dt))
+    t0 = time.perf_counter()
+    ea.integrate(ea.PositionVerlet(), sim, steps * dt, steps, progress_bar=False)
+    wall = time.perf_counter() - t0
+    tip = rod.position_collection[:2, -1]
+    return {"elements": n, "clamp": "shifted by half an element" if shifted else "stock (node 0)",
+            "timestep_s": dt, "stability_limit_s": 2.0 / omega_sr, "steps": steps, "wall_s": wall,
+            "tip_m": tip.tolist(), "finite": bool(np.isfinite(rod.position_collection).all())}
+
+
+def bench_elastica(T=0.05, elements=20, with_pyelastica=True):
+    from mjeap import analytical as an
+    b = _beam_numbers()
+    P = b["EI"] / b["L"] ** 2
+    ref = an.elastica_tip_force(P, b["L"], b["EI"]).tip
+
+    def err(row):
+        x, y = row["tip_m"]
+        row["tip_deflection_error"] = y / ref[1] - 1
+        row["tip_axial_error_per_L"] = (x - ref[0]) / b["L"]
+        return row
+
+    out = {"case": f"pedot-micro beam (L {b['L']:.4g} m, EI {b['EI']:.4g} N m^2), dead tip force with "
+                   f"P L^2/EI = 1, gravity off, first-mode damping ratio {ELASTICA_ZETA}, {T} s simulated",
+           "elastica_tip_m": [float(ref[0]), float(ref[1])], "simulated_s": T,
+           "mjeap": [err(_mjeap_cantilever(b, T, P, n)) for n in (20, 50)],
+           "mjeap_with_drive_callback": [err(_mjeap_cantilever(b, T, P, 20, drive=d))
+                                         for d in ("blocking-force", "rc-relaxation")]}
+    out["mjeap_with_drive_callback"][0]["drive"] = "blocking-force at 0 V (no moment): the callback's cost alone"
+    out["mjeap_with_drive_callback"][1]["drive"] = ("rc-relaxation at 0 V: seed 000's drive; its back-relaxation "
+                                                    "creeps the beam, so the tip is not the elastic one")
+    if not with_pyelastica:
+        return out
+    try:
+        import elastica  # noqa: F401
+    except ImportError:
+        out["pyelastica"] = "not installed (pip install -e '.[bench]')"
+        return out
+    out["pyelastica"] = [err(_pyelastica_cantilever(b, T, P, elements, shifted)) for shifted in (True, False)]
+    pe = out["pyelastica"][0]
+    base = out["mjeap"][0]
+    out["ratio"] = {
+        "pyelastica_shifted_over_mjeap_20": pe["wall_s"] / base["wall_s"],
+        "pyelastica_shifted_over_mjeap_20_with_rc_relaxation_callback":
+            pe["wall_s"] / out["mjeap_with_drive_callback"][1]["wall_s"],
+        "pyelastica_shifted_over_mjeap_20_with_blocking_force_callback":
+            pe["wall_s"] / out["mjeap_with_drive_callback"][0]["wall_s"],
+        "note": "equal accuracy: both tip errors below 0.1 % (PyElastica needs the half-element clamp shift; "
+                "its stock clamp is off by several % at this resolution and would need many more elements)"}
+    return out
+
+
+def bench_sweep(points=16, duration=2.0):
+    """Rollouts per second of the same sweep on 1 and 2 worker processes (pool start
+    included), and the memory of one rollout (tracemalloc peak, which sees NumPy's
+    buffers, plus the MjModel and MjData)."""
+    import tempfile
+    import tracemalloc
+    from mjeap import rollout
+    from mjeap.sweep import grid, run_sweep
+    pts = grid(payload_mass=list(np.linspace(1e-6, 12.6e-6, points // 2)), amplitude=[0.5, 1.0])
+    base = {"actuator": "pedot-micro", "orientation": "up", "waveform": "square", "frequency": 0.5,
+            "duration": duration, "payload_position": 6.27e-3}
+    out = {"case": f"pedot-micro up, payload x amplitude grid, {len(pts)} points of {duration} s"}
+    with tempfile.TemporaryDirectory() as d:
+        for workers in (1, 2):
+            res = run_sweep(pts, Path(d) / f"w{workers}.csv", base=base, workers=workers, progress=False)
+            out[f"workers_{workers}"] = {"rollouts_per_s": res.throughput, "wall_s": res.wall_s,
+                                         "failed": res.failed}
+    out["speedup_2_vs_1"] = out["workers_2"]["rollouts_per_s"] / out["workers_1"]["rollouts_per_s"]
+    from mjeap import Payload
+    s = Scene("pedot-micro", orientation="up", payload=Payload(12.6e-6, 6.27e-3))
+    rollout(s, "square:1V@0.5Hz", 0.1)                        # warm caches
+    tracemalloc.start()
+    r = rollout(s, "square:1V@0.5Hz", duration)
+    _, peak = tracemalloc.get_traced_memory()
+    tracemalloc.stop()
+    result_bytes = sum(a.nbytes for a in (r.time, r.voltage, r.tip_position, r.tip_angle, r.tip_curvature,
+                                          r.centreline)) + sum(a.nbytes for a in r.signals.values())
+    out["memory_per_rollout"] = {"python_peak_bytes": peak, "result_arrays_bytes": result_bytes,
+                                 "samples": len(r.time), "mjmodel_bytes": int(s.model.nbuffer),
+                                 "mjdata_bytes": int(s.data.nbuffer + s.data.narena)}
+    return out
+
+
+BENCHMARKS = ("models", "rollout", "drives", "threaded", "elastica", "sweep")
+
+
 def main():
-    ap = argparse.ArgumentParser(description=__doc__)
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--json", help="also write the results to this file")
     ap.add_argument("--min-seconds", type=float, default=0.5, help="timing window per measurement")
-    ap.add_argument("--only", choices=["models", "rollout"], help="run one benchmark")
+    ap.add_argument("--only", choices=BENCHMARKS, action="append", help="run these benchmarks (repeatable)")
+    ap.add_argument("--elastica-time", type=float, default=0.05,
+                    help="simulated time of the elastica benchmark (s); PyElastica takes ~1 min per 0.05 s")
+    ap.add_argument("--no-pyelastica", action="store_true", help="mjeap side of the elastica benchmark only")
     args = ap.parse_args()
+    only = args.only or BENCHMARKS
     out = {"machine": {"python": platform.python_version(), "mujoco": mujoco.__version__,
                        "processor": platform.processor() or platform.machine(), "cpus": os.cpu_count()}}
-    if args.only in (None, "models"):
-        out["models"] = bench_models(args.min_seconds)
-    if args.only in (None, "rollout"):
-        import tempfile
-        with tempfile.TemporaryDirectory() as d:
-            out["rollout"] = bench_rollout(d)
-    text = json.dumps(out, indent=2)
-    print(text)
-    if args.json:
-        Path(args.json).write_text(text)
+
+    def emit():
+        text = json.dumps(out, indent=2)
+        if args.json:    # written after every benchmark: nothing measured is lost
+            Path(args.json).parent.mkdir(parents=True, exist_ok=True)
+            Path(args.json).write_text(text)
+        return text
+
+    for name in BENCHMARKS:
+        if name not in only:
+            continue
+        if name == "models":
+            out["models"] = bench_models(args.min_seconds)
+        elif name == "rollout":
+            import tempfile
+            with tempfile.TemporaryDirectory() as d:
+                out["rollout"] = bench_rollout(d)
+        elif name == "drives":
+            out["drives"] = bench_drives()
+        elif name == "threaded":
+            out["threaded"] = bench_threaded()
+        elif name == "elastica":
+            out["elastica"] = bench_elastica(args.elastica_time, with_pyelastica=not args.no_pyelastica)
+        elif name == "sweep":
+            out["sweep"] = bench_sweep()
+        emit()
+    print(emit())
 
 
 if __name__ == "__main__":

@@ -14,21 +14,8 @@ from pathlib import Path
 
 import numpy as np
 
-from mjeap import analytical as an
+from mjeap.stability import MAP_BASE, column_limits, simulated_edges
 from mjeap.sweep import EXECUTORS, grid, read_results, run_sweep
-
-L_E = 6.27e-3          # m, seed 000's payload position
-L = 6e-3
-
-
-def boundaries():
-    model = an.DadrasModel()
-    ei, g = 1.0 / model.mechanical_gain, model.gravity
-    p_arm = an.critical_load_with_arm(L, ei, L_E - L)
-    return {"column, instantaneous EI": p_arm / g,
-            "column, relaxed EI (static limit)": model.pole / model.zero * p_arm / g,
-            "paper's Region 3 model (marginal)": model.marginal_mass(L_E)}
-
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -42,26 +29,15 @@ def main(argv=None):
     masses = np.linspace(0.0, 150e-6, a.masses)[1:]
     amps = np.linspace(0.25, 1.5, a.amplitudes)
     points = grid(payload_mass=[float(m) for m in masses], amplitude=[float(v) for v in amps])
-    base = dict(actuator="pedot-micro", orientation="up", payload_position=L_E, waveform="square",
-                frequency=0.1, duration=30.0)
-    s = run_sweep(points, out / "results.csv", metrics=("returns", "peak_to_peak", "max_stress_proxy"), base=base,
+    s = run_sweep(points, out / "results.csv", metrics=("returns", "peak_to_peak", "max_stress_proxy"), base=MAP_BASE,
                   executor=a.executor, workers=a.workers)
     print(f"{s.done} rollouts in {s.wall_s:.1f} s ({s.throughput:.2f}/s), {s.skipped} already done, {s.failed} failed")
     rows = read_results(out / "results.csv")
     m = np.array([float(r["payload_mass"]) for r in rows]) * 1e6
     v = np.array([float(r["amplitude"]) for r in rows])
     ok = np.array([r["returns"] == "True" for r in rows])
-    bounds = {k: b * 1e6 for k, b in boundaries().items()}
-
-    # the simulated boundary per amplitude: midway between the heaviest returning and the
-    # lightest non-returning mass
-    sim_edge = {}
-    for amp in np.unique(v):
-        sel = v == amp
-        good, bad = m[sel & ok], m[sel & ~ok]
-        if good.size and bad.size:
-            sim_edge[float(amp)] = 0.5 * (good.max() + bad[bad > good.max()].min()) if (bad > good.max()).any() \
-                else float("nan")
+    bounds = {k: b * 1e6 for k, b in column_limits().items()}
+    sim_edge = simulated_edges(m, v, ok)
     lines = ["# Stability map: pedot-micro standing up, payload at l_e = 6.27 mm, 0.1 Hz square wave", "",
              f"{len(rows)} points; criterion: tip curvature changes sign in the third period (seed 000).", "",
              "| amplitude (V) | simulated limit (mg) |", "|---|---|"]
