@@ -53,6 +53,8 @@ class BeamBuilder:
     """Interface: add a discretised beam under the clamp body of a spec."""
 
     representation: str = ""
+    #: generalised dofs per hinge (sizes the MjData arena)
+    dofs_per_hinge: int = 1
 
     def skeleton_xml(self, layout: BeamLayout, units: UnitSystem) -> str:
         """XML placed inside the clamp body before parsing (composites must be parsed)."""
@@ -82,6 +84,7 @@ class HingeChainBuilder(BeamBuilder):
     """Planar chain: N links, N hinge springs about the local z axis."""
 
     representation = "hinge"
+    dofs_per_hinge = 1
 
     def build(self, spec, layout, units):
         parent = spec.body("clamp")
@@ -110,6 +113,7 @@ class CableBuilder(BeamBuilder):
     """MuJoCo composite cable with the elasticity plugin (3D bending and twist)."""
 
     representation = "cable"
+    dofs_per_hinge = 3          # ball joints
     prefix = "cable"
 
     def extensions_xml(self) -> str:
@@ -173,6 +177,14 @@ def get_builder(representation: str) -> BeamBuilder:
         raise UnknownNameError("representation", str(representation), BUILDERS) from None
 
 
+def arena_bytes(nv: int) -> int:
+    """MjData arena (bytes) for a beam of ``nv`` dofs: no contacts or constraints, so the
+    largest need is the finite-difference linearisation (mjd_transitionFD, one (2 nv)^2
+    matrix of doubles on the stack), taken twice, plus 1 MiB. MuJoCo's own default sizes
+    for legacy contact buffers (about 14 MiB per MjData), which these scenes never use."""
+    return (1 << 20) + 2 * 8 * (2 * nv) ** 2
+
+
 def build_spec(layout: BeamLayout, representation: str = "hinge", orientation: str = "horizontal",
                payload: Optional[Payload] = None, units: Optional[UnitSystem] = None,
                gravity: bool = True, model_name: Optional[str] = None):
@@ -206,6 +218,7 @@ def build_spec(layout: BeamLayout, representation: str = "hinge", orientation: s
   </worldbody>
 </mujoco>"""
     spec = mujoco.MjSpec.from_string(xml)
+    spec.memory = arena_bytes(layout.segments * builder.dofs_per_hinge)
     handles = builder.build(spec, layout, units)
     tip = spec.body(handles.tip_body)
     tip_local = (layout.tip_x - layout.link_start[-1]) / units.length

@@ -3,7 +3,9 @@ import mujoco
 import pytest
 
 from mjeap import DEFAULT_UNITS, analytical as an, get_actuator, load_mjcf
+from mjeap import Scene
 from mjeap.assets import ASSET_DIR, asset_name, asset_xml, iter_assets
+from mjeap.mjcf import arena_bytes
 
 ASSETS = list(iter_assets())
 
@@ -40,3 +42,16 @@ def test_asset_compiles_and_stays_at_rest_for_1s(actuator_id, representation):
     assert abs(dx[1]) < 1e-9 * L
     assert abs(dx[0]) < 1e-9 * L + 2 * sag**2 / L  # the sag's geometric shortening
     assert abs(dx[2]) <= 2 * sag + 1e-12 * L
+
+
+@pytest.mark.parametrize("representation,segments", [("hinge", 20), ("cable", 20), ("hinge", 150), ("cable", 60)])
+def test_arena_is_sized_to_the_beam(representation, segments):
+    """The MjData arena is sized from the dofs (no contacts: the finite-difference
+    linearisation is the largest need), not MuJoCo's ~14 MiB default: a 20-hinge scene
+    holds about 1 MiB, and long beams still build (their linearisation fits) and step."""
+    s = Scene("pedot-micro", representation=representation, segments=segments)
+    assert s.data.narena == arena_bytes(s.model.nv)
+    if segments == 20:
+        assert s.data.narena < 2 * 2**20
+    s.run(20 * s.timestep)
+    assert s.data.maxuse_arena < s.data.narena
