@@ -82,16 +82,19 @@ class RolloutResult:
 
 
 class _Samples:
-    """Preallocated sample arrays of one rollout, filled from the scene's present state
-    (kinematics up to date) and the drive's signals."""
+    """Preallocated sample arrays of one rollout. A sample copies MuJoCo's raw world
+    positions (clamp, links, payload, tip site) and the tip's orientation, and the drive's
+    signals; the clamp-frame SI read-outs (the same arithmetic as Scene.centreline,
+    tip_position, tip_angle, payload_position) are computed for all samples at once at the
+    end, so a sample costs a few copies."""
 
     def __init__(self, scene: Scene, ns: int):
         self.scene, self.ns = scene, ns
-        N = scene.layout.segments
+        self._bodies = np.r_[scene.clamp_id, scene.link_ids, [scene.payload_id] if scene.payload_id >= 0 else []]
+        self._bodies = self._bodies.astype(np.intp)
+        self._xpos = np.empty((ns, len(self._bodies), 3))
+        self._site, self._xmat = np.empty((ns, 3)), np.empty((ns, 9))
         self.t, self.v = np.empty(ns), np.empty(ns)
-        self.tip, self.ang, self.kap = np.empty((ns, 3)), np.empty(ns), np.empty(ns)
-        self.cl = np.empty((ns, N + 2, 3))
-        self.pay = np.empty((ns, 3)) if scene.payload is not None else None
         self.sig: Dict[str, np.ndarray] = {}
         self.n = 0                                  # samples taken
 
@@ -101,16 +104,15 @@ class _Samples:
         self.sig[key][i] = value
 
     def take(self, t: float, v: float, drive, controller=None) -> None:
-        """Sample the state after the step that ended at ``t`` s, ``v`` the voltage held over
-        that step (the first sample: the first step's), the instant the drive signals describe."""
+        """Sample the state after the step that ended at ``t`` s (kinematics up to date),
+        ``v`` the voltage held over that step (the first sample: the first step's), the
+        instant the drive signals describe."""
         sc, i = self.scene, self.n
+        d = sc.data
         self.t[i], self.v[i] = t, v
-        self.cl[i] = sc.centreline()
-        self.tip[i] = self.cl[i, -1]                # the centreline ends at the tip point
-        self.ang[i] = sc.tip_angle()
-        self.kap[i] = arc_curvature(self.tip[i, 0], self.tip[i, 1])
-        if self.pay is not None:
-            self.pay[i] = sc.payload_position()
+        np.take(d.xpos, self._bodies, axis=0, out=self._xpos[i], mode="clip")
+        self._site[i] = d.site_xpos[sc.tip_site_id]
+        self._xmat[i] = d.xmat[sc.tip_body_id]
         for k, x in drive.signals().items():
             self._put(k, i, x)
         if controller is not None and hasattr(controller, "signals"):
@@ -119,10 +121,18 @@ class _Samples:
         self.n += 1
 
     def result(self, drive, initial_curvature: float, meta: dict) -> RolloutResult:
-        n = self.n
+        n, sc = self.n, self.scene
+        R, u, N = sc.rotation, sc.units.length, sc.layout.segments
+        clamp = self._xpos[:n, :1]
+        pts = np.concatenate([self._xpos[:n, :N + 1], self._site[:n, None]], axis=1)   # clamp, hinges, tip
+        cl = (pts - clamp) @ R * u
+        tip = cl[:, -1].copy()                      # the centreline ends at the tip point
+        rel = R.T @ self._xmat[:n].reshape(n, 3, 3)
+        ang = np.arctan2(rel[:, 1, 0], rel[:, 0, 0])
+        kap = arc_curvature(tip[:, 0], tip[:, 1])
+        pay = (self._xpos[:n, -1] - clamp[:, 0]) @ R * u if sc.payload_id >= 0 else None
         ref = drive.reference_curvature(self.t[:n], self.v[:n], initial_curvature) if n > 1 else None
-        return RolloutResult(self.t[:n], self.v[:n], self.tip[:n], self.ang[:n], self.kap[:n], self.cl[:n],
-                             None if self.pay is None else self.pay[:n],
+        return RolloutResult(self.t[:n], self.v[:n], tip, ang, kap, cl, pay,
                              {k: x[:n] for k, x in self.sig.items()}, ref, meta)
 
 

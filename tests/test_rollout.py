@@ -144,3 +144,17 @@ def test_tip_force_acts_as_a_dead_load_through_rollouts():
     assert r.meta["engine"] == "loop"
     assert r.tip_position[-1, 1] == pytest.approx(ref[1], rel=5e-3)
     assert r.tip_position[-1, 0] == pytest.approx(ref[0], abs=5e-3 * L)
+
+
+@pytest.mark.parametrize("representation", ["hinge", "cable"])
+def test_samples_equal_the_scene_read_outs(representation):
+    """Samples store raw MuJoCo positions and are converted at the end: the last sample
+    equals the scene's own SI read-outs at the final state (rotated clamp, payload)."""
+    from mjeap import Payload
+    s = Scene("pedot-micro", representation=representation, orientation="up", payload=Payload(5e-6, 4e-3))
+    r = rollout(s, "sine:1V@2Hz", 0.3, initial_curvature=-50.0)
+    np.testing.assert_allclose(r.centreline[-1], s.centreline(), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(r.tip_position[-1], s.tip_position(), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(r.payload_position[-1], s.payload_position(), rtol=0, atol=1e-15)
+    assert r.tip_angle[-1] == pytest.approx(s.tip_angle(), abs=1e-13)
+    assert r.tip_curvature[-1] == pytest.approx(s.tip_curvature(), rel=1e-12)
