@@ -90,10 +90,11 @@ class _Samples:
 
     def __init__(self, scene: Scene, ns: int):
         self.scene, self.ns = scene, ns
-        self._bodies = np.r_[scene.clamp_id, scene.link_ids, [scene.payload_id] if scene.payload_id >= 0 else []]
-        self._bodies = self._bodies.astype(np.intp)
-        self._xpos = np.empty((ns, len(self._bodies), 3))
-        self._site, self._xmat = np.empty((ns, 3)), np.empty((ns, 9))
+        N = scene.layout.segments
+        # raw world points per sample: clamp, the N link origins, the tip site, the payload
+        self._bodies = np.r_[scene.clamp_id, scene.link_ids].astype(np.intp)
+        self._raw = np.empty((ns, N + 2 + (scene.payload_id >= 0), 3))
+        self._xmat = np.empty((ns, 9))
         self.t, self.v = np.empty(ns), np.empty(ns)
         self.sig: Dict[str, np.ndarray] = {}
         self.n = 0                                  # samples taken
@@ -110,8 +111,11 @@ class _Samples:
         sc, i = self.scene, self.n
         d = sc.data
         self.t[i], self.v[i] = t, v
-        np.take(d.xpos, self._bodies, axis=0, out=self._xpos[i], mode="clip")
-        self._site[i] = d.site_xpos[sc.tip_site_id]
+        raw, N = self._raw[i], sc.layout.segments
+        np.take(d.xpos, self._bodies, axis=0, out=raw[:N + 1], mode="clip")
+        raw[N + 1] = d.site_xpos[sc.tip_site_id]
+        if sc.payload_id >= 0:
+            raw[N + 2] = d.xpos[sc.payload_id]
         self._xmat[i] = d.xmat[sc.tip_body_id]
         for k, x in drive.signals().items():
             self._put(k, i, x)
@@ -121,16 +125,18 @@ class _Samples:
         self.n += 1
 
     def result(self, drive, initial_curvature: float, meta: dict) -> RolloutResult:
+        """The SI result; called once, at the end (it works on the raw arrays in place)."""
         n, sc = self.n, self.scene
         R, u, N = sc.rotation, sc.units.length, sc.layout.segments
-        clamp = self._xpos[:n, :1]
-        pts = np.concatenate([self._xpos[:n, :N + 1], self._site[:n, None]], axis=1)   # clamp, hinges, tip
-        cl = (pts - clamp) @ R * u
+        raw = self._raw[:n]
+        raw -= raw[:, :1].copy()                    # relative to the clamp (in place)
+        cl = raw[:, :N + 2] @ R                     # clamp, hinges, tip
+        cl *= u
         tip = cl[:, -1].copy()                      # the centreline ends at the tip point
         rel = R.T @ self._xmat[:n].reshape(n, 3, 3)
         ang = np.arctan2(rel[:, 1, 0], rel[:, 0, 0])
         kap = arc_curvature(tip[:, 0], tip[:, 1])
-        pay = (self._xpos[:n, -1] - clamp[:, 0]) @ R * u if sc.payload_id >= 0 else None
+        pay = raw[:, N + 2] @ R * u if sc.payload_id >= 0 else None
         ref = drive.reference_curvature(self.t[:n], self.v[:n], initial_curvature) if n > 1 else None
         return RolloutResult(self.t[:n], self.v[:n], tip, ang, kap, cl, pay,
                              {k: x[:n] for k, x in self.sig.items()}, ref, meta)
