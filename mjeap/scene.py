@@ -328,8 +328,8 @@ class Scene:
             a = np.arctan2(self._quat_wz[1], self._quat_wz[0], out=out)
             a *= 2.0
             return a
-        q = self.data.qpos
-        a = q[self.joint_qpos].copy() if self.representation == "hinge" else \
+        q = self.data.qpos                         # indexed fallback (copies)
+        a = q[self.joint_qpos] if self.representation == "hinge" else \
             2 * np.arctan2(q[self.joint_qpos + 3], q[self.joint_qpos])
         if out is None:
             return a
