@@ -14,8 +14,8 @@ How: the drive computes the moment history of the whole run up front
 ``qfrc_applied`` controls, in internal units, and the states come back for every step, in
 chunks that keep memory bounded. Steps run in C, many rollouts share a thread pool. The
 samples are read back by putting the sampled state into the scene's MjData
-(``mj_setState`` + ``mj_kinematics``) and the drive at that step (:meth:`Drive.seek`), so
-they are the lockstep loop's read-outs exactly.
+(``mj_setState`` + ``mj_kinematics``) and the drive at that step (:meth:`Drive.seek`,
+which replays the drive's own step), so they are the lockstep loop's read-outs exactly.
 """
 from __future__ import annotations
 
@@ -110,9 +110,8 @@ def run(scene, drives: Sequence, v_steps: Sequence[np.ndarray], initial_curvatur
         raise _error(scene, drives[-1], v_steps[-1][-1], B - 1, B, "MuJoCo warned of a bad acceleration on the "
                      "last step; ")
     # leave the scene and the (last) drive as the lockstep loop does: final state, the
-    # moments of the last step still applied
+    # moments of the last step still applied (seek replays that step)
     mujoco.mj_setState(m, d, state0[-1], STATE)
-    d.qfrc_applied[bend] = moments[-1][-1]
     drives[-1].seek(n)
     scene._step_count = n
     scene.update_kinematics()

@@ -169,12 +169,26 @@ class Drive:
     def open_loop_moments(self, v_steps: np.ndarray) -> np.ndarray:
         """Bending moment (N m) at every hinge over every step from reset, (steps, segments),
         for the voltages ``v_steps`` (V) held over the steps; afterwards :meth:`seek` works."""
-        raise NotImplementedError(f"{self.name}: {self.closed_loop_reason()}")
+        self._v_history = np.asarray(v_steps, dtype=float)
+        return self._moment_history(self._v_history)
 
     def seek(self, k: int) -> None:
         """After :meth:`open_loop_moments`: put the drive in its state after ``k`` steps, so
-        that :meth:`signals` reads what the lockstep loop would (the scene holds the beam)."""
+        that :meth:`signals` reads what the lockstep loop would (the scene holds the beam).
+        It replays the drive's own :meth:`step` k from the state before that step."""
+        if k == 0:
+            self.reset()
+            return
+        self._restore_before(k - 1)
+        self.step(float(self._v_history[k - 1]), self.scene.timestep)
+
+    # hooks of the two above, for open-loop drives
+    def _moment_history(self, v: np.ndarray) -> np.ndarray:
+        """Vectorised: the moments (N m), (steps, segments), that :meth:`step` applies."""
         raise NotImplementedError(f"{self.name}: {self.closed_loop_reason()}")
+
+    def _restore_before(self, k: int) -> None:
+        """Set the drive's own state to what it is before step ``k`` (none by default)."""
 
     def describe(self) -> str:
         return f"{self.name} ({self.model_used})" if self.model_used else self.name

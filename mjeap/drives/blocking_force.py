@@ -75,19 +75,16 @@ class BlockingForceDrive(Drive):
     def closed_loop_reason(self):
         return "its stiffness table changes the beam's stiffness with the voltage" if self.stiffness.v.size else None
 
-    def open_loop_moments(self, v_steps):
+    def _moment_history(self, v):
         """The first-order force by scipy.signal.lfilter of the same exact (ZOH) recursion
         x[k+1] = a x[k] + b v[k] the loop steps; the moment over step k uses x[k]."""
-        v = np.asarray(v_steps, dtype=float)
         a, b = float(self.force.Ad[0, 0]), float(self.force.Bd[0])
-        x = signal.lfilter([0.0, b], [1.0, -a], v)                  # x[0] .. x[n-1]
-        self._hist = np.append(x, a * x[-1] + b * v[-1])            # .. x[n]
-        m = 2.0 / 3.0 * self.L * x
+        self._force_history = signal.lfilter([0.0, b], [1.0, -a], v)     # x[0] .. x[n-1]
+        m = 2.0 / 3.0 * self.L * self._force_history
         return np.repeat(m[:, None], self.scene.layout.segments, axis=1)
 
-    def seek(self, k: int) -> None:
-        self.force.x[:] = self._hist[k]
-        self._moment = 2.0 / 3.0 * float(self._hist[k - 1]) * self.L if k else 0.0
+    def _restore_before(self, k: int) -> None:
+        self.force.x[:] = self._force_history[k]
 
     def signals(self) -> Dict[str, float]:
         return {"blocking_force (N)": float(self.force.x[0, 0]), "drive_moment (N m)": float(self._moment),

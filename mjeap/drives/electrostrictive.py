@@ -102,17 +102,8 @@ class ElectrostrictiveDrive(Drive):
     def closed_loop_reason(self):
         return None if self.factors is None else "field stiffening changes the beam's stiffness with the voltage"
 
-    def open_loop_moments(self, v_steps):
-        self._hist = np.asarray(v_steps, dtype=float)
-        m = self._M_per_V2 * self._hist ** 2
-        return np.repeat(m[:, None], self.scene.layout.segments, axis=1)
-
-    def seek(self, k: int) -> None:
-        if k == 0:
-            self._E = self._M = 0.0
-            return
-        v = float(self._hist[k - 1])
-        self._E, self._M = v / self.t_active, self._M_per_V2 * v * v
+    def _moment_history(self, v):
+        return np.repeat((self._M_per_V2 * v ** 2)[:, None], self.scene.layout.segments, axis=1)
 
     def step(self, voltage: float, dt: float) -> None:
         if voltage != self._v_last:  # the drive is static in V: recompute only on change

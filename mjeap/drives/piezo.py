@@ -82,19 +82,11 @@ class PiezoBimorphDrive(Drive):
     def closed_loop_reason(self):
         return None
 
-    def open_loop_moments(self, v_steps):
-        self._hist = np.asarray(v_steps, dtype=float)
-        return np.multiply.outer(self._hist - 0.5 * self.params["bias"], self.gamma)
+    def _moment_history(self, v):
+        return np.multiply.outer(v - 0.5 * self.params["bias"], self.gamma)
 
-    def seek(self, k: int) -> None:
-        v, dt = self._hist, self.scene.timestep
-        if k == 0:                              # as reset() leaves it
-            self._v, self._v_prev, self._dv = self.rest_voltage(), None, 0.0
-            self._m[:] = 0.0
-            return
-        self._v = self._v_prev = float(v[k - 1])
-        self._dv = 0.0 if k == 1 else (v[k - 1] - v[k - 2]) / dt
-        np.multiply(self.gamma, self._v - 0.5 * self.params["bias"], out=self._m)
+    def _restore_before(self, k: int) -> None:
+        self._v_prev = None if k == 0 else float(self._v_history[k - 1])
 
     def currents(self):
         """(resistive, capacitive, motional) current of eq. (1), A, at the scene's present
