@@ -84,9 +84,9 @@ class RolloutResult:
 class _Samples:
     """Preallocated sample arrays of one rollout. A sample copies MuJoCo's raw world
     positions (clamp, links, payload, tip site) and the tip's orientation, and the drive's
-    signals; the clamp-frame SI read-outs (the same arithmetic as Scene.centreline,
-    tip_position, tip_angle, payload_position) are computed for all samples at once at the
-    end, so a sample costs a few copies."""
+    signals; the clamp-frame SI read-outs (Scene.clamp_frame and in_plane_angle, as the
+    Scene's own read-outs use) are computed for all samples at once at the end, so a
+    sample costs a few copies."""
 
     def __init__(self, scene: Scene, ns: int):
         self.scene, self.ns = scene, ns
@@ -127,16 +127,14 @@ class _Samples:
     def result(self, drive, initial_curvature: float, meta: dict) -> RolloutResult:
         """The SI result; called once, at the end (it works on the raw arrays in place)."""
         n, sc = self.n, self.scene
-        R, u, N = sc.rotation, sc.units.length, sc.layout.segments
+        N = sc.layout.segments
         raw = self._raw[:n]
         raw -= raw[:, :1].copy()                    # relative to the clamp (in place)
-        cl = raw[:, :N + 2] @ R                     # clamp, hinges, tip
-        cl *= u
+        cl = sc.clamp_frame(raw[:, :N + 2])         # clamp, hinges, tip
         tip = cl[:, -1].copy()                      # the centreline ends at the tip point
-        rel = R.T @ self._xmat[:n].reshape(n, 3, 3)
-        ang = np.arctan2(rel[:, 1, 0], rel[:, 0, 0])
+        ang = sc.in_plane_angle(self._xmat[:n])
         kap = arc_curvature(tip[:, 0], tip[:, 1])
-        pay = raw[:, N + 2] @ R * u if sc.payload_id >= 0 else None
+        pay = sc.clamp_frame(raw[:, N + 2]) if sc.payload_id >= 0 else None
         ref = drive.reference_curvature(self.t[:n], self.v[:n], initial_curvature) if n > 1 else None
         return RolloutResult(self.t[:n], self.v[:n], tip, ang, kap, cl, pay,
                              {k: x[:n] for k, x in self.sig.items()}, ref, meta)

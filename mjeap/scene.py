@@ -506,8 +506,21 @@ class Scene:
                               f"(tip still moving by {np.linalg.norm(now - last):.3g} m per period)")
 
     # ------------------------------------------------------------------ read-outs (SI)
+    def clamp_frame(self, p_rel: np.ndarray) -> np.ndarray:
+        """World-axis offsets from the clamp (internal units, any leading shape) to the
+        clamp frame in m."""
+        out = p_rel @ self.rotation
+        out *= self.units.length
+        return out
+
+    def in_plane_angle(self, xmat: np.ndarray) -> np.ndarray:
+        """Rotation (rad) about the hinge axis, relative to the clamp, of body frames given
+        as flattened world rotation matrices (..., 9)."""
+        rel = self.rotation.T @ np.reshape(xmat, (-1, 3, 3))
+        return np.arctan2(rel[:, 1, 0], rel[:, 0, 0]).reshape(np.shape(xmat)[:-1])
+
     def _to_clamp(self, p_world: np.ndarray) -> np.ndarray:
-        return (p_world - self.data.xpos[self.clamp_id]) @ self.rotation * self.units.length
+        return self.clamp_frame(p_world - self.data.xpos[self.clamp_id])
 
     def tip_position(self) -> np.ndarray:
         """Tip point in the clamp frame (axial x, deflection y, out-of-plane z), m."""
@@ -515,8 +528,7 @@ class Scene:
 
     def tip_angle(self) -> float:
         """Rotation of the tip about the hinge axis relative to the clamp, rad."""
-        R = self.rotation.T @ self.data.xmat[self.tip_body_id].reshape(3, 3)
-        return float(np.arctan2(R[1, 0], R[0, 0]))
+        return float(self.in_plane_angle(self.data.xmat[self.tip_body_id]))
 
     def tip_curvature(self) -> float:
         """Curvature (1/m) of the arc through clamp and tip, tangent at the clamp (seed 000)."""
