@@ -22,9 +22,11 @@ from typing import Dict
 import numpy as np
 from scipy import signal
 
+from ..analytical import DadrasModel
 from .base import Drive, register_drive, zoh_first_order
 
 _SRC = "Dadras et al. 2021 (seed 000), eq. 8 (identified from a 3 V step)"
+_EQ8 = DadrasModel()      # the identified numbers live there, once
 
 
 @register_drive
@@ -33,10 +35,10 @@ class RCRelaxationDrive(Drive):
     actuators = ("pedot-micro",)
     model_used = "lumped RC + standard-linear-solid back-relaxation"
     PARAMETERS = {"pedot-micro": {
-        "gain": (63.0, "1/(m s)", _SRC),
-        "zero": (0.52, "1/s", _SRC + "; mechanical zero"),
-        "pole_mechanical": (0.3, "1/s", _SRC + "; mechanical pole"),
-        "pole_electrical": (1.8, "1/s", _SRC + "; electrical pole 1/RC"),
+        "gain": (_EQ8.k_tf, "1/(m s)", _SRC),
+        "zero": (_EQ8.zero, "1/s", _SRC + "; mechanical zero"),
+        "pole_mechanical": (_EQ8.pole, "1/s", _SRC + "; mechanical pole"),
+        "pole_electrical": (_EQ8.electrical_pole, "1/s", _SRC + "; electrical pole 1/RC"),
         "capacitance": (1e-3, "F", "assumed (not in the source); only scales the reported charge and current"),
     }}
 
