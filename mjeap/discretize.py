@@ -173,13 +173,19 @@ def check_payload(payload: Optional[Payload], layout: BeamLayout) -> None:
 ORIENTATIONS: Tuple[str, ...] = ("horizontal", "up", "down")
 
 
-def clamp_rotation(orientation: str) -> np.ndarray:
+def clamp_rotation(orientation) -> np.ndarray:
     """World rotation of the clamp frame (columns: beam axis x, deflection y, hinge axis z).
 
     horizontal: bending plane horizontal (hinge axis vertical), gravity out of the plane;
     up: beam points against gravity (seed 000's inverted payload case);
-    down: beam hangs along gravity.
+    down: beam hangs along gravity. A 3 x 3 rotation matrix is taken as it is (an
+    actuator attached to a tilted mount, :func:`mjeap.attach`).
     """
+    if not isinstance(orientation, str):
+        R = np.asarray(orientation, dtype=float)
+        if R.shape != (3, 3) or not np.allclose(R.T @ R, np.eye(3), atol=1e-9) or np.linalg.det(R) < 0:
+            raise ParameterError("orientation", orientation, f"one of {', '.join(ORIENTATIONS)} or a 3x3 rotation matrix")
+        return R
     if orientation == "horizontal":
         return np.eye(3)
     if orientation == "up":

@@ -83,22 +83,38 @@ def _stable_part(K: np.ndarray, M: np.ndarray) -> np.ndarray:
     return (Mphi * np.clip(lam, 0.0, None)) @ Mphi.T
 
 
-def spectral_radius(lin: Linearization, damping: np.ndarray, h: float, integrator: str) -> float:
-    """Spectral radius of MuJoCo's linearised one-step map at timestep ``h``.
+def step_map(lin: Linearization, damping: np.ndarray, h: float, integrator: str, gravity: bool = False) -> np.ndarray:
+    """MuJoCo's linearised one-step map (x, v) -> (x+, v+) at timestep ``h`` (2 nv x 2 nv).
 
     Velocity update with implicit damping D and implicit joint stiffness K_i (only under
     ``discrete``), the rest of the stiffness K_e explicit, then x+ = x + h v+:
     (M + h D + h^2 K_i) v+ = M v - h (K_i + K_e) x.
-    Gravity stiffness is left out: it sets the physics (buckling), not the numerics.
+    Gravity stiffness is left out unless ``gravity``: it sets the physics (buckling), not
+    the numerics.
     """
-    M, K = lin.M, _stable_part(lin.K_elastic, lin.M)
+    M = lin.M
+    K = lin.K if gravity else _stable_part(lin.K_elastic, lin.M)
     Ki = lin.K_joint if integrator == "discrete" else np.zeros_like(K)
     A = M + h * np.diag(damping) + h * h * Ki
     AinvK = np.linalg.solve(A, K)
     AinvM = np.linalg.solve(A, M)
     n = M.shape[0]
-    T = np.block([[np.eye(n) - h * h * AinvK, h * AinvM], [-h * AinvK, AinvM]])
-    return float(np.max(np.abs(np.linalg.eigvals(T))))
+    return np.block([[np.eye(n) - h * h * AinvK, h * AinvM], [-h * AinvK, AinvM]])
+
+
+def spectral_radius(lin: Linearization, damping: np.ndarray, h: float, integrator: str) -> float:
+    """Spectral radius of :func:`step_map` (stable where <= 1)."""
+    return float(np.max(np.abs(np.linalg.eigvals(step_map(lin, damping, h, integrator)))))
+
+
+def first_mode_damping(lin: Linearization, damping: np.ndarray, h: float, integrator: str) -> tuple:
+    """(frequency in rad per internal time, damping ratio) of the lowest oscillating mode of
+    the discrete step map, gravity included: what the simulation really does per step,
+    integrator and all, from the eigenvalue lambda = exp(mu h), mu = -zeta w +- i w sqrt(1 - zeta^2)."""
+    lam = np.linalg.eigvals(step_map(lin, damping, h, integrator, gravity=True))
+    mu = np.log(lam[np.abs(lam.imag) > 1e-12].astype(complex)) / h
+    i = np.argmin(np.abs(mu))
+    return float(np.abs(mu[i])), float(-mu[i].real / np.abs(mu[i]))
 
 
 def stability_limit(lin: Linearization, damping: np.ndarray, integrator: str, h_max: float) -> float:

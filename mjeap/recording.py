@@ -126,3 +126,128 @@ def read_recording(path) -> dict:
     for chunk in RrdReader(str(path)).stream():
         out.setdefault(chunk.entity_path, []).append(chunk.to_record_batch())
     return out
+
+
+def _geom_archetype(rr, model, g: int, length: float, color):
+    """A Rerun archetype drawing geom ``g`` in its body's frame (SI), or None."""
+    T = mujoco_types()
+    t, size = model.geom_type[g], model.geom_size[g] * length
+    pos = model.geom_pos[g] * length
+    q = model.geom_quat[g]
+    rot = rr.Quaternion(xyzw=[q[1], q[2], q[3], q[0]])
+    if t == T.mjGEOM_BOX:
+        return rr.Boxes3D(half_sizes=[size], centers=[pos], quaternions=[rot], colors=[color], fill_mode="solid")
+    if t == T.mjGEOM_SPHERE:
+        return rr.Ellipsoids3D(half_sizes=[[size[0]] * 3], centers=[pos], colors=[color], fill_mode="solid")
+    if t == T.mjGEOM_ELLIPSOID:
+        return rr.Ellipsoids3D(half_sizes=[size], centers=[pos], quaternions=[rot], colors=[color], fill_mode="solid")
+    if t in (T.mjGEOM_CAPSULE, T.mjGEOM_CYLINDER):
+        # MuJoCo: along the local z axis, half-length size[1], centred; Rerun: from the origin along +z
+        R = np.zeros(9)
+        import mujoco
+        mujoco.mju_quat2Mat(R, q)
+        start = pos - R.reshape(3, 3)[:, 2] * size[1]
+        cls = rr.Capsules3D if t == T.mjGEOM_CAPSULE else rr.Cylinders3D
+        if cls is rr.Capsules3D:
+            return cls(lengths=[2 * size[1]], radii=[size[0]], translations=[start], quaternions=[rot], colors=[color])
+        return cls(lengths=[2 * size[1]], radii=[size[0]], centers=[pos], rotations=[rot], colors=[color])
+    return None
+
+
+def mujoco_types():
+    import mujoco
+    return mujoco.mjtGeom
+
+
+def write_system_recording(path, result, system) -> Path:
+    """Write a :class:`mjeap.system.SystemResult` to ``path`` (.rrd): every beam's
+    centreline and tip (world frame, m), every other body's geoms (boxes, spheres,
+    ellipsoids, capsules, cylinders) moving with their bodies, and per actuator its voltage
+    and tip curvature; the net contact force on every body that touches something."""
+    import rerun as rr
+    import rerun.blueprint as rrb
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    m, L = system.model, system.units.length
+    names = [a.prefix.rstrip("/") for a in system.actuators]
+    groups = [rrb.TimeSeriesView(origin=f"/plots/{n}", name=f"{n}: tip curvature (1/m), voltage (V)") for n in names]
+    touched = [b for b in range(m.nbody) if len(result.time) and np.abs(result.contact_force[:, b]).max() > 0]
+    if touched:
+        groups.append(rrb.TimeSeriesView(origin="/plots/contact", name="contact force (N)"))
+    bp = rrb.Blueprint(rrb.Horizontal(rrb.Spatial3DView(origin="/world", name="system (m)"), rrb.Vertical(*groups),
+                                      column_shares=[3, 2]),
+                       rrb.BlueprintPanel(state="collapsed"), rrb.SelectionPanel(state="collapsed"))
+    rec = rr.RecordingStream("mjeap", recording_id=f"system-{'-'.join(names)}")
+    rec.save(str(path), default_blueprint=bp)
+    try:
+        rec.log("meta", rr.TextDocument(json.dumps(result.meta, indent=1, default=str), media_type="text/markdown"),
+                static=True)
+        t = result.time
+        n = len(t)
+        beam_bodies = set()
+        for p in system.parts:
+            beam_bodies.update(int(b) for b in p.link_ids)
+            beam_bodies.update({p.tip_load_id, p.clamp_id})
+        idx = np.arange(0, n, max(1, n // MAX_FRAMES)) if n else np.zeros(0, int)
+        tf = rr.TimeColumn("time", duration=t[idx]) if n else None
+        # rigid bodies other than the beams: their geoms, posed per frame
+        for b in range(1, m.nbody):
+            if b in beam_bodies or m.body_geomnum[b] == 0:
+                continue
+            ent = f"world/bodies/{result.body_names[b]}"
+            for g in range(m.body_geomadr[b], m.body_geomadr[b] + m.body_geomnum[b]):
+                rgba = (np.clip(m.geom_rgba[g], 0, 1) * 255).astype(np.uint8)
+                arch = _geom_archetype(rr, m, g, L, rgba)
+                if arch is not None:
+                    rec.log(f"{ent}/geom{g - m.body_geomadr[b]}", arch, static=True)
+            if n:
+                q = result.body_quat[idx, b]
+                rec.send_columns(ent, indexes=[tf], columns=rr.Transform3D.columns(
+                    translation=result.body_position[idx, b], quaternion=q[:, [1, 2, 3, 0]]))
+        for name, p, a in zip(names, system.parts, system.actuators):
+            r = result.actuators[name]
+            if not n:
+                continue
+            # the centreline back in the world: clamp position + clamp rotation x clamp-frame points
+            R = p.rotation if p._fixed_rotation is not None else None
+            clamp = result.body_position[idx, p.clamp_id]
+            pts = r.centreline[idx]
+            if R is not None:
+                world = clamp[:, None, :] + pts @ R.T
+            else:
+                Rs = np.array([_quat_mat(q) for q in result.body_quat[idx, p.clamp_id]])
+                world = clamp[:, None, :] + np.einsum("nij,nkj->nki", Rs, pts)
+            rec.send_columns(f"world/{name}/centreline", indexes=[tf],
+                             columns=rr.LineStrips3D.columns(strips=list(world)).partition([1] * len(idx)))
+            rec.log(f"world/{name}/centreline", rr.LineStrips3D.from_fields(
+                colors=[[50, 115, 205]], radii=[0.5 * p.layout.thickness]), static=True)
+            rec.send_columns(f"world/{name}/tip", indexes=[tf], columns=rr.Points3D.columns(positions=world[:, -1]))
+            rec.log(f"world/{name}/tip", rr.Points3D.from_fields(radii=[0.01 * p.layout.length],
+                                                                colors=[[255, 80, 30]]), static=True)
+            cols = [(f"plots/{name}/tip_curvature", r.tip_curvature, f"{name}: tip curvature (1/m)")]
+            if a.drive is not None:
+                cols.append((f"plots/{name}/voltage", r.voltage, f"{name}: voltage (V)"))
+            for ent, y, label in cols:
+                rec.log(ent, rr.SeriesLines(names=label), static=True)
+                rec.send_columns(ent, indexes=[rr.TimeColumn("time", duration=t)],
+                                 columns=rr.Scalars.columns(scalars=np.asarray(y, dtype=float)))
+        for b in touched:
+            ent = f"plots/contact/{result.body_names[b].replace('/', '_')}"
+            rec.log(ent, rr.SeriesLines(names=f"{result.body_names[b]}: |contact force| (N)"), static=True)
+            rec.send_columns(ent, indexes=[rr.TimeColumn("time", duration=t)],
+                             columns=rr.Scalars.columns(scalars=np.linalg.norm(result.contact_force[:, b], axis=1)))
+        if "error" in result.meta:
+            if n:
+                rec.set_time("time", duration=float(t[-1]))
+            rec.log("log", rr.TextLog(result.meta["error"], level="ERROR"))
+    finally:
+        rec.flush()
+        rec.disconnect()
+    return path
+
+
+def _quat_mat(q) -> np.ndarray:
+    import mujoco
+    R = np.zeros(9)
+    mujoco.mju_quat2Mat(R, np.asarray(q, dtype=float))
+    return R.reshape(3, 3)

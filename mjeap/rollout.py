@@ -21,7 +21,7 @@ import csv
 import time as _time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Dict, List, Optional, Sequence, Union
+from typing import Dict, List, Optional, Sequence, Tuple, Union
 
 import mujoco
 import numpy as np
@@ -40,7 +40,7 @@ except ImportError:  # pragma: no cover
 DEFAULT_SAMPLES = 5000
 #: runs of more steps than this show a progress bar (when progress is None)
 PROGRESS_STEPS = 200_000
-ENGINES = ("auto", "loop", "threaded")
+ENGINES = ("auto", "loop", "threaded", "native")
 
 
 @dataclass
@@ -82,19 +82,22 @@ class RolloutResult:
 
 
 class _Samples:
-    """Preallocated sample arrays of one rollout. A sample copies MuJoCo's raw world
-    positions (clamp, links, payload, tip site) and the tip's orientation, and the drive's
-    signals; the clamp-frame SI read-outs (Scene.clamp_frame and in_plane_angle, as the
-    Scene's own read-outs use) are computed for all samples at once at the end, so a
-    sample costs a few copies."""
+    """Preallocated sample arrays of one rollout of one actuator (an
+    :class:`~mjeap.component.ActuatorPart`). A sample copies MuJoCo's raw world positions
+    (clamp, links, payload, tip site), the tip's orientation (and the clamp's, where the
+    clamp can move) and the drive's signals; the clamp-frame SI read-outs (the part's
+    clamp_frame and in_plane_angle, as its own read-outs use) are computed for all samples
+    at once at the end, so a sample costs a few copies."""
 
-    def __init__(self, scene: Scene, ns: int):
-        self.scene, self.ns = scene, ns
-        N = scene.layout.segments
+    def __init__(self, part, ns: int):
+        self.part, self.ns = part, ns
+        N = part.layout.segments
         # raw world points per sample: clamp, the N link origins, the tip site, the payload
-        self._bodies = np.r_[scene.clamp_id, scene.link_ids].astype(np.intp)
-        self._raw = np.empty((ns, N + 2 + (scene.payload_id >= 0), 3))
+        self._bodies = np.r_[part.clamp_id, part.link_ids].astype(np.intp)
+        self._raw = np.empty((ns, N + 2 + (part.payload_id >= 0), 3))
         self._xmat = np.empty((ns, 9))
+        self._moving = part._fixed_rotation is None
+        self._clamp_xmat = np.empty((ns, 9)) if self._moving else None
         self.t, self.v = np.empty(ns), np.empty(ns)
         self.sig: Dict[str, np.ndarray] = {}
         self.n = 0                                  # samples taken
@@ -104,38 +107,51 @@ class _Samples:
             self.sig[key] = np.full(self.ns, np.nan)
         self.sig[key][i] = value
 
-    def take(self, t: float, v: float, drive, controller=None) -> None:
+    def take(self, t: float, v: float, signals: Dict[str, float], controller=None) -> None:
         """Sample the state after the step that ended at ``t`` s (kinematics up to date),
         ``v`` the voltage held over that step (the first sample: the first step's), the
-        instant the drive signals describe."""
-        sc, i = self.scene, self.n
-        d = sc.data
+        instant the drive's ``signals`` describe."""
+        p, i = self.part, self.n
+        d = p.data
         self.t[i], self.v[i] = t, v
-        raw, N = self._raw[i], sc.layout.segments
+        raw, N = self._raw[i], p.layout.segments
         np.take(d.xpos, self._bodies, axis=0, out=raw[:N + 1], mode="clip")
-        raw[N + 1] = d.site_xpos[sc.tip_site_id]
-        if sc.payload_id >= 0:
-            raw[N + 2] = d.xpos[sc.payload_id]
-        self._xmat[i] = d.xmat[sc.tip_body_id]
-        for k, x in drive.signals().items():
+        raw[N + 1] = d.site_xpos[p.tip_site_id]
+        if p.payload_id >= 0:
+            raw[N + 2] = d.xpos[p.payload_id]
+        self._xmat[i] = d.xmat[p.tip_body_id]
+        if self._moving:
+            self._clamp_xmat[i] = d.xmat[p.clamp_id]
+        for k, x in signals.items():
             self._put(k, i, x)
         if controller is not None and hasattr(controller, "signals"):
             for k, x in controller.signals().items():
                 self._put(f"controller_{k}", i, x)
         self.n += 1
 
+    def _to_clamp(self, raw: np.ndarray, xmat: np.ndarray):
+        """Clamp-frame points (m) and tip angles (rad) of raw samples."""
+        p = self.part
+        if not self._moving:
+            return p.clamp_frame(raw), p.in_plane_angle(xmat)
+        R = self._clamp_xmat[:len(raw)].reshape(-1, 3, 3)
+        pts = np.einsum("n...j,njk->n...k", raw, R) * p.units.length
+        rel = np.einsum("nji,njk->nik", R, xmat.reshape(-1, 3, 3))
+        return pts, np.arctan2(rel[:, 1, 0], rel[:, 0, 0])
+
     def result(self, drive, initial_curvature: float, meta: dict) -> RolloutResult:
         """The SI result; called once, at the end (it works on the raw arrays in place)."""
-        n, sc = self.n, self.scene
-        N = sc.layout.segments
+        n, p = self.n, self.part
+        N = p.layout.segments
         raw = self._raw[:n]
         raw -= raw[:, :1].copy()                    # relative to the clamp (in place)
-        cl = sc.clamp_frame(raw[:, :N + 2])         # clamp, hinges, tip
+        pts, ang = self._to_clamp(raw, self._xmat[:n])
+        cl = pts[:, :N + 2]                         # clamp, hinges, tip
         tip = cl[:, -1].copy()                      # the centreline ends at the tip point
-        ang = sc.in_plane_angle(self._xmat[:n])
         kap = arc_curvature(tip[:, 0], tip[:, 1])
-        pay = sc.clamp_frame(raw[:, N + 2]) if sc.payload_id >= 0 else None
-        ref = drive.reference_curvature(self.t[:n], self.v[:n], initial_curvature) if n > 1 else None
+        pay = pts[:, N + 2] if p.payload_id >= 0 else None
+        ref = drive.reference_curvature(self.t[:n], self.v[:n], initial_curvature) \
+            if (n > 1 and drive is not None) else None
         return RolloutResult(self.t[:n], self.v[:n], tip, ang, kap, cl, pay,
                              {k: x[:n] for k, x in self.sig.items()}, ref, meta)
 
@@ -166,18 +182,24 @@ def _meta(scene, drv, wave, duration, initial_curvature, n_steps, engine) -> dic
             "drive_parameters": {k: [v, drv.sources.get(k, "")] for k, v in drv.params.items()}}
 
 
-def _choose_engine(engine: str, scene, drv, controller) -> str:
-    from . import threaded
+def _choose_engine(engine: str, scene, drv, controller) -> Tuple[str, str]:
+    """The engine for this run and why: 'native' where the drive has a native form,
+    else 'threaded' where it is open-loop, else 'loop' (``auto``); a named engine that does
+    not apply is refused with the reason."""
+    from . import native, threaded
     if engine not in ENGINES:
         raise ParameterError("engine", engine, f"one of {', '.join(ENGINES)}")
     if engine == "loop":
-        return "loop"
-    why = threaded.why_not(scene, drv, controller)
-    if why is None:
-        return "threaded"
-    if engine == "threaded":
-        raise ParameterError("engine", "threaded", f"'loop' or 'auto' for this run: {why}")
-    return "loop"
+        return "loop", "asked for"
+    why = {"native": native.why_not(scene, drv, controller), "threaded": threaded.why_not(scene, drv, controller)}
+    if engine != "auto":
+        if why[engine] is not None:
+            raise ParameterError("engine", engine, f"'loop' or 'auto' for this run: {why[engine]}")
+        return engine, "asked for"
+    for i, e in enumerate(why):
+        if why[e] is None:
+            return e, "; ".join(["auto"] + [f"not {x}: {why[x]}" for x in list(why)[:i]])
+    return "loop", "; ".join(["auto"] + [f"not {x}: {w}" for x, w in why.items()])
 
 
 def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: float,
@@ -203,13 +225,15 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     wave = None if controller is not None else _waveform(voltage, duration)
     drv = drive if (drive is not None and not isinstance(drive, str)) else \
         make_drive(drive, scene, **(drive_params or {}))
-    engine = _choose_engine(engine, scene, drv, controller)
+    engine, engine_reason = _choose_engine(engine, scene, drv, controller)
     dt = scene.timestep
     v_steps = _voltage_steps(wave, duration, dt, drv)
     n_steps = len(v_steps)
     sample_steps = _sample_steps(n_steps, dt, sample_interval)
-    samples = _Samples(scene, len(sample_steps))
+    nat = scene.native_model(drv) if engine == "native" else None
+    samples = _Samples(scene.part if nat is None else nat.part, len(sample_steps))
     meta = _meta(scene, drv, wave, duration, initial_curvature, n_steps, engine)
+    meta["engine_reason"] = engine_reason
     if controller is not None:
         meta["controller"] = getattr(controller, "name", type(controller).__name__)
     error = None
@@ -217,6 +241,8 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     try:
         if engine == "threaded":
             threaded.run(scene, [drv], [v_steps], [initial_curvature], sample_steps, [samples], nthread=0)
+        elif engine == "native":
+            threaded.run_native(scene, nat, [drv], [v_steps], [initial_curvature], sample_steps, [samples], nthread=0)
         else:
             _run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, progress, check_every,
                       controller, meta)
@@ -255,7 +281,8 @@ def _run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, pro
 
     def sample(step):
         scene.update_kinematics()
-        samples.take(step * dt, v_hold if controller is not None else v_steps[max(step - 1, 0)], drv, controller)
+        samples.take(step * dt, v_hold if controller is not None else v_steps[max(step - 1, 0)], drv.signals(),
+                     controller)
 
     try:
         sample(0)
@@ -298,11 +325,14 @@ def _run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, pro
 def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable]], duration: float,
                   drive: Optional[str] = None, drive_params: Optional[dict] = None,
                   initial_curvatures: Union[float, Sequence[float]] = 0.0,
-                  sample_interval: Optional[float] = None, nthread: Optional[int] = None) -> List[RolloutResult]:
-    """Many open-loop rollouts of one scene, one per entry of ``voltages`` (and of
-    ``initial_curvatures``, 1/m, a scalar for all), on MuJoCo's native threaded rollout
-    with ``nthread`` threads (default: one per CPU). Same results as :func:`rollout` run
-    one by one; raises ParameterError where the threaded path does not apply."""
+                  sample_interval: Optional[float] = None, nthread: Optional[int] = None,
+                  engine: str = "auto") -> List[RolloutResult]:
+    """Many rollouts of one scene, one per entry of ``voltages`` (and of
+    ``initial_curvatures``, 1/m, a scalar for all), on MuJoCo's threaded rollout with
+    ``nthread`` threads (default: one per CPU): the drive compiled into the model
+    (``native``) or its moment history as applied forces (``threaded``); ``auto`` takes
+    the first that applies. Same results as :func:`rollout` run one by one with that
+    engine; raises ParameterError where neither applies."""
     import os
     from .drives import make_drive
     from . import threaded
@@ -313,19 +343,25 @@ def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable
         raise ParameterError("voltages", voltages, "at least one waveform")
     kappa0 = np.broadcast_to(np.asarray(initial_curvatures, dtype=float), (len(voltages),))
     drives = [make_drive(drive, scene, **(drive_params or {})) for _ in voltages]
-    _choose_engine("threaded", scene, drives[0], None)
+    engine, _ = _choose_engine(engine, scene, drives[0], None)
+    if engine == "loop":
+        _choose_engine("threaded", scene, drives[0], None)      # raises, with the reason
     dt = scene.timestep
     waves = [_waveform(v, duration) for v in voltages]
     v_steps = [_voltage_steps(w, duration, dt, d) for w, d in zip(waves, drives)]
     sample_steps = _sample_steps(len(v_steps[0]), dt, sample_interval)
-    samples = [_Samples(scene, len(sample_steps)) for _ in voltages]
+    nat = scene.native_model(drives[0]) if engine == "native" else None
+    samples = [_Samples(scene.part if nat is None else nat.part, len(sample_steps)) for _ in voltages]
     nthread = (os.cpu_count() or 1) if nthread is None else int(nthread)
     wall0 = _time.perf_counter()
-    threaded.run(scene, drives, v_steps, list(kappa0), sample_steps, samples, nthread=nthread)
+    if nat is None:
+        threaded.run(scene, drives, v_steps, list(kappa0), sample_steps, samples, nthread=nthread)
+    else:
+        threaded.run_native(scene, nat, drives, v_steps, list(kappa0), sample_steps, samples, nthread=nthread)
     wall = _time.perf_counter() - wall0
     out = []
     for w, d, k0, smp in zip(waves, drives, kappa0, samples):
-        meta = _meta(scene, d, w, duration, float(k0), len(v_steps[0]), "threaded")
+        meta = _meta(scene, d, w, duration, float(k0), len(v_steps[0]), engine)
         meta.update(wall_time_s=wall, batch=len(voltages), nthread=nthread)
         out.append(smp.result(d, float(k0), meta))
     return out

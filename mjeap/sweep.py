@@ -36,7 +36,7 @@ EXECUTORS = ("processes", "serial", "dask")
 PARAMETERS: Dict[str, object] = {
     "actuator": "pedot-micro", "representation": "hinge", "segments": 20, "orientation": "horizontal",
     "payload_mass": 0.0, "payload_position": None, "waveform": "square", "amplitude": 1.0, "frequency": 0.1,
-    "offset": 0.0, "duration": None, "initial_curvature": 0.0, "damping_ratio": None,
+    "offset": 0.0, "duration": None, "initial_curvature": 0.0, "damping_ratio": None, "engine": "auto",
 }
 
 
@@ -164,7 +164,7 @@ def evaluate(point: dict, metrics: Sequence[str] = ("peak_to_peak", "returns"), 
         drive_params = {k[6:]: v for k, v in p.items() if k.startswith("drive.")}
         rrd = None if rrd_dir is None else Path(rrd_dir) / f"point-{row['point_id']}.rrd"
         r = rollout(scene, wave, float(duration), drive_params=drive_params, initial_curvature=float(p["initial_curvature"]),
-                    progress=False, rrd=rrd)
+                    progress=False, rrd=rrd, engine=p["engine"])
         for m in metrics:
             row[m] = METRICS[m](r, p, scene)
     except MjeapError as e:

@@ -29,6 +29,8 @@ from .errors import DivergenceError
 
 STATE = mujoco.mjtState.mjSTATE_FULLPHYSICS
 CONTROL = mujoco.mjtState.mjSTATE_QFRC_APPLIED
+NATIVE_CONTROL = mujoco.mjtState.mjSTATE_CTRL
+LOADS = mujoco.mjtState.mjSTATE_XFRC_APPLIED
 #: the state and control arrays of one chunk stay below this size
 CHUNK_BYTES = 64 * 2**20
 #: MuJoCo's mjMAXVAL: larger state entries count as diverged, as mj_checkPos/Vel do
@@ -52,11 +54,56 @@ def why_not(scene, drive, controller=None) -> Optional[str]:
     return None
 
 
+def roll(model, state0: np.ndarray, controls, ncontrol: int, control_spec, n: int, sample_steps: np.ndarray,
+         take, nthread: int = 0) -> tuple:
+    """The core of both engines: ``mujoco.rollout`` of ``len(state0)`` runs of ``model`` over
+    ``n`` steps, in chunks that keep memory bounded. ``controls(s0, c, out)`` fills the
+    (B, c, ncontrol) controls of steps s0 .. s0 + c; ``take(b, k, state)`` is called for
+    every run b at every sample step k >= 1 with its state after that step. Returns
+    (final states (B, nstate), None) or, at the first bad state (not finite, beyond
+    mjMAXVAL, or after a step on which MuJoCo warned), (None, (run, step, state)), after
+    taking the samples before it."""
+    B = len(state0)
+    nstate = mujoco.mj_stateSize(model, STATE)
+    chunk = int(max(1, min(n, CHUNK_BYTES // (8 * B * (nstate + ncontrol)))))
+    datas = [mujoco.MjData(model) for _ in range(max(nthread, 1))]
+    control = np.zeros((B, chunk, ncontrol))
+    i_next = 1                                      # next sample index (same for all runs)
+    with mj_rollout.Rollout(nthread=nthread) as pool:
+        for s0 in range(0, n, chunk):
+            c = min(chunk, n - s0)
+            controls(s0, c, control[:, :c])
+            state, _ = pool.rollout(model, datas, state0, control[:, :c], control_spec=control_spec, nstep=c)
+            # a state is bad if not finite or beyond mjMAXVAL (internal units keep it near 1),
+            # or if it follows a step on which MuJoCo warned: the rollout then stops and
+            # repeats its last state, so time stops advancing there
+            finite = (np.abs(state[:, :, 1:]) < MAXVAL).all(axis=2)          # (B, c)
+            times = np.concatenate([state0[:, :1], state[:, :, 0]], axis=1)
+            frozen = np.diff(times, axis=1) <= 0
+            finite[:, :-1] &= ~frozen[:, 1:]
+            bad = int(np.argmin(finite.all(axis=0))) if not finite.all() else c
+            # samples up to the first bad step of any run
+            while i_next < len(sample_steps) and sample_steps[i_next] <= s0 + bad:
+                k = int(sample_steps[i_next])
+                for b in range(B):
+                    take(b, k, state[b, k - s0 - 1])
+                i_next += 1
+            if bad < c:
+                b = int(np.argmin(finite[:, bad]))
+                return None, (b, s0 + bad + 1, state[b, bad])
+            state0 = np.ascontiguousarray(state[:, c - 1])
+    if any(x.warning[mujoco.mjtWarning.mjWARN_BADQACC].number for x in datas):
+        # a warning on the very last step leaves no repeated state behind it
+        return None, (B - 1, n, None)
+    return state0, None
+
+
 def run(scene, drives: Sequence, v_steps: Sequence[np.ndarray], initial_curvatures: Sequence[float],
         sample_steps: np.ndarray, samples: Sequence, nthread: int = 0) -> None:
     """Roll out ``len(drives)`` runs of ``scene`` (one drive, voltage history, initial
     curvature and sample store each) with ``nthread`` threads (0: the calling thread),
-    filling the sample stores. Raises DivergenceError at the first non-finite state."""
+    filling the sample stores; the drives' moments are qfrc_applied controls. Raises
+    DivergenceError at the first non-finite state."""
     m, d = scene.model, scene.data
     B, n = len(drives), len(v_steps[0])
     nstate, nv = mujoco.mj_stateSize(m, STATE), m.nv
@@ -70,48 +117,90 @@ def run(scene, drives: Sequence, v_steps: Sequence[np.ndarray], initial_curvatur
         moments.append(drives[b].open_loop_moments(v_steps[b]) * scale)
         drives[b].seek(0)
         scene.update_kinematics()
-        samples[b].take(0.0, v_steps[b][0], drives[b])
-    chunk = int(max(1, min(n, CHUNK_BYTES // (8 * B * (nstate + nv)))))
-    datas = [mujoco.MjData(m) for _ in range(max(nthread, 1))]
-    control = np.zeros((B, chunk, nv))
-    i_next = 1                                      # next sample index (same for all runs)
-    with mj_rollout.Rollout(nthread=nthread) as pool:
-        for s0 in range(0, n, chunk):
-            c = min(chunk, n - s0)
-            for b in range(B):
-                control[b][:c, bend] = moments[b][s0:s0 + c]
-            state, _ = pool.rollout(m, datas, state0, control[:, :c], control_spec=CONTROL, nstep=c)
-            # a state is bad if not finite or beyond mjMAXVAL (internal units keep it near 1),
-            # or if it follows a step on which MuJoCo warned: the rollout then stops and
-            # repeats its last state, so time stops advancing there
-            finite = (np.abs(state[:, :, 1:]) < MAXVAL).all(axis=2)          # (B, c)
-            times = np.concatenate([state0[:, :1], state[:, :, 0]], axis=1)
-            frozen = np.diff(times, axis=1) <= 0
-            finite[:, :-1] &= ~frozen[:, 1:]
-            bad = int(np.argmin(finite.all(axis=0))) if not finite.all() else c
-            # samples up to the first bad step of any run
-            while i_next < len(sample_steps) and sample_steps[i_next] <= s0 + bad:
-                k = int(sample_steps[i_next])
-                for b in range(B):
-                    mujoco.mj_setState(m, d, state[b, k - s0 - 1], STATE)
-                    scene.update_kinematics()
-                    drives[b].seek(k)
-                    samples[b].take(k * dt, v_steps[b][k - 1], drives[b])
-                i_next += 1
-            if bad < c:
-                b = int(np.argmin(finite[:, bad]))
-                mujoco.mj_setState(m, d, state[b, bad], STATE)
-                scene._step_count = s0 + bad + 1
-                raise _error(scene, drives[b], v_steps[b][s0 + bad], b, B)
-            state0 = np.ascontiguousarray(state[:, c - 1])
-    if any(x.warning[mujoco.mjtWarning.mjWARN_BADQACC].number for x in datas):
-        # a warning on the very last step leaves no repeated state behind it
-        scene._step_count = n
-        raise _error(scene, drives[-1], v_steps[-1][-1], B - 1, B, "MuJoCo warned of a bad acceleration on the "
-                     "last step; ")
+        samples[b].take(0.0, v_steps[b][0], drives[b].signals())
+
+    def controls(s0, c, out):
+        for b in range(B):
+            out[b][:, bend] = moments[b][s0:s0 + c]
+
+    def take(b, k, state):
+        mujoco.mj_setState(m, d, state, STATE)
+        scene.update_kinematics()
+        drives[b].seek(k)
+        samples[b].take(k * dt, v_steps[b][k - 1], drives[b].signals())
+
+    final, bad = roll(m, state0, controls, nv, CONTROL, n, sample_steps, take, nthread)
+    if bad is not None:
+        raise_bad(scene, lambda x: mujoco.mj_setState(m, d, x, STATE), drives, v_steps, bad)
     # leave the scene and the (last) drive as the lockstep loop does: final state, the
     # moments of the last step still applied (seek replays that step)
-    mujoco.mj_setState(m, d, state0[-1], STATE)
+    mujoco.mj_setState(m, d, final[-1], STATE)
     drives[-1].seek(n)
     scene._step_count = n
     scene.update_kinematics()
+
+
+def raise_bad(scene, put, drives, v_steps, bad) -> None:
+    """Raise the DivergenceError of a bad state found by :func:`roll`, after ``put(state)``
+    has put the scene in it."""
+    b, step, state = bad
+    B = len(drives)
+    scene._step_count = step
+    if state is None:
+        raise _error(scene, drives[b], v_steps[b][-1], b, B, "MuJoCo warned of a bad acceleration on the last step; ")
+    put(state)
+    raise _error(scene, drives[b], v_steps[b][step - 1], b, B)
+
+
+def run_native(scene, native, drives: Sequence, v_steps: Sequence[np.ndarray], initial_curvatures: Sequence[float],
+               sample_steps: np.ndarray, samples: Sequence, nthread: int = 0) -> None:
+    """As :func:`run`, on the scene's native model (:class:`mjeap.native.NativeModel`): the
+    controls are the voltages themselves (the actuator's ctrl), the drive runs inside
+    MuJoCo. The scene is left in the final state of the last run (its beam dofs)."""
+    m, d, part, h = native.model, native.data, native.part, native.handles
+    B, n = len(drives), len(v_steps[0])
+    dt, a = scene.timestep, native.actuator_id
+    state0 = np.empty((B, mujoco.mj_stateSize(m, STATE)))
+    # the controls: the voltage (ctrl), and the tip loads where the scene has them
+    spec = NATIVE_CONTROL | (LOADS if scene.part.has_tip_load() else 0)
+    template = np.empty(mujoco.mj_stateSize(m, spec))
+    for drv in drives:          # the drives' signals read the native model's state
+        drv.part = part
+    for b in range(B):
+        native.drive = drives[b]
+        native.reset(initial_curvatures[b])
+        mujoco.mj_getState(m, d, state0[b], STATE)
+        mujoco.mj_getState(m, d, template, spec)
+        drives[b].native_prepare(v_steps[b])
+        samples[b].take(0.0, v_steps[b][0], drives[b].native_signals(0, part, h))
+
+    def controls(s0, c, out):
+        out[:] = template
+        for b in range(B):
+            out[b][:, a] = v_steps[b][s0:s0 + c]     # ctrl comes first in a composite state
+
+    def put(state):
+        mujoco.mj_setState(m, d, state, STATE)
+        mujoco.mj_kinematics(m, d)
+        sd, nq, nv = scene.data, scene.model.nq, scene.model.nv     # the beam's dofs come first
+        sd.qpos[:], sd.qvel[:], sd.time = d.qpos[:nq], d.qvel[:nv], d.time
+        scene.update_kinematics()
+
+    def take(b, k, state):
+        mujoco.mj_setState(m, d, state, STATE)
+        mujoco.mj_kinematics(m, d)
+        samples[b].take(k * dt, v_steps[b][k - 1], drives[b].native_signals(k, part, h))
+
+    try:
+        final, bad = roll(m, state0, controls, len(template), spec, n, sample_steps, take, nthread)
+        if bad is not None:
+            raise_bad(scene, put, drives, v_steps, bad)
+        put(final[-1])
+    finally:
+        for drv in drives:
+            drv.part = scene.part
+    # the scene and the (last) drive as the loop leaves them: final state, last moments applied
+    mujoco.mj_setState(m, d, final[-1], STATE)
+    mujoco.mj_kinematics(m, d)
+    drives[-1].native_leave(n, part, h)
+    scene._step_count = n

@@ -22,6 +22,11 @@ drive callback running every step.
 
 sweep: rollouts per second of a 16-point sweep on 1 and 2 local worker processes, and the
 memory of one rollout.
+
+native: seed 000's drive compiled into the model (mjeap.native) against the lockstep loop,
+side by side: the heaviest experiment as one rollout, a batch of 16 on 2 threads against the
+loop one by one, mj_step of the native model against the bare beam, and the stability
+map's 30 s points per second on 2 workers with either engine.
 """
 import argparse
 import json
@@ -164,7 +169,7 @@ def _beam_numbers():
             "f1": float(s.choice.first_frequency)}
 
 
-def _mjeap_cantilever(b, T, P, segments, drive=None, repeats=3):
+def _mjeap_cantilever(b, T, P, segments, drive=None, repeats=3, engine="loop"):
     """Best-of-``repeats`` wall time of T s simulated; tip at the end (m)."""
     from mjeap import rollout
     s = Scene("pedot-micro", gravity=False, damping_ratio=ELASTICA_ZETA, segments=segments)
@@ -176,12 +181,13 @@ def _mjeap_cantilever(b, T, P, segments, drive=None, repeats=3):
         if drive is None:
             s.run(T)
         else:
-            rollout(s, "step:0V", T, drive=drive, sample_interval=T, engine="loop")
+            rollout(s, "step:0V", T, drive=drive, sample_interval=T, engine=engine)
         best = min(best, time.perf_counter() - t0)
     tip = s.tip_position()
     s.run(0.1 * T)
     moved = float(np.linalg.norm(s.tip_position() - tip) / b["L"])
-    return {"segments": segments, "timestep_s": s.timestep, "steps": int(round(T / s.timestep)),
+    return {"segments": segments, "engine": engine if drive else "scene.run", "timestep_s": s.timestep,
+            "steps": int(round(T / s.timestep)),
             "integrator": s.integrator, "wall_s": best, "tip_m": tip[:2].tolist(),
             "tip_moved_over_next_10pct_per_L": moved}
 
@@ -319,7 +325,53 @@ def bench_sweep(points=16, duration=2.0):
     return out
 
 
-BENCHMARKS = ("models", "rollout", "drives", "threaded", "elastica", "sweep")
+def bench_native(repeats=2, map_points=8):
+    from mjeap import Payload, rollout, rollout_batch
+    from mjeap.drives import make_drive
+    from mjeap.stability import MAP_BASE
+    from mjeap.sweep import grid, run_sweep
+    s = Scene("pedot-micro", orientation="up", payload=Payload(12.6e-6, 6.27e-3))
+    args = dict(duration=20.0, initial_curvature=-303.0, progress=False)
+    out = {"case": "pedot-micro, 12.6 mg @ 6.27 mm, up, square 3 Vpp 0.1 Hz, 20 s, from -303 1/m",
+           "timestep_s": s.timestep}
+    for engine in ("loop", "native"):
+        best = np.inf
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            r = rollout(s, "square:1.5V@0.1Hz", engine=engine, **args)
+            best = min(best, time.perf_counter() - t0)
+        out[f"single_{engine}_s"] = best
+        out[f"single_{engine}_us_per_step"] = best / r.meta["steps"] * 1e6
+    out["steps"] = r.meta["steps"]
+    out["single_speedup_native_vs_loop"] = out["single_loop_s"] / out["single_native_s"]
+    volts = [f"square:{a:.4g}V@0.1Hz" for a in np.linspace(0.5, 1.5, 16)]
+    t0 = time.perf_counter()
+    for v in volts:
+        rollout(s, v, engine="loop", **args)
+    out["batch16_loop_s"] = time.perf_counter() - t0
+    t0 = time.perf_counter()
+    rollout_batch(s, volts, 20.0, initial_curvatures=-303.0, nthread=2, engine="native")
+    out["batch16_native_2threads_s"] = time.perf_counter() - t0
+    out["batch16_throughput_native_vs_loop"] = out["batch16_loop_s"] / out["batch16_native_2threads_s"]
+    native = s.native_model(make_drive(None, s))
+    s.reset(curvature=-303.0)
+    out["mj_step_bare_us"] = 1e6 / time_steps(s.model, s.data)
+    native.reset(-303.0)
+    out["mj_step_native_us"] = 1e6 / time_steps(native.model, native.data)
+    out["native_step_cost_vs_bare"] = out["mj_step_native_us"] / out["mj_step_bare_us"]
+    out["native_nv"], out["bare_nv"] = native.model.nv, s.model.nv
+    pts = grid(payload_mass=list(np.linspace(15e-6, 120e-6, map_points // 2)), amplitude=[0.5, 1.5])
+    import tempfile
+    with tempfile.TemporaryDirectory() as d:
+        for engine in ("loop", "native"):
+            res = run_sweep(pts, Path(d) / f"{engine}.csv", base={**MAP_BASE, "engine": engine}, workers=2,
+                            progress=False)
+            out[f"stability_map_{engine}_rollouts_per_s"] = res.throughput
+    out["stability_map_points"] = len(pts)
+    return out
+
+
+BENCHMARKS = ("models", "rollout", "drives", "threaded", "elastica", "sweep", "native")
 
 
 def main():
@@ -359,6 +411,8 @@ def main():
             out["elastica"] = bench_elastica(args.elastica_time, with_pyelastica=not args.no_pyelastica)
         elif name == "sweep":
             out["sweep"] = bench_sweep()
+        elif name == "native":
+            out["native"] = bench_native()
         emit()
     print(emit())
 

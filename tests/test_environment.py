@@ -39,7 +39,7 @@ def test_env_steps_the_drive_exactly_like_rollout():
         k_env.append(ts.observation["tip_curvature"][0])
         t_env.append(env.physics.time())
     sc = Scene("pedot-micro", orientation="up", payload=Payload(12.6e-6, 6.27e-3))
-    r = rollout(sc, "step:1V", t_env[-1], sample_interval=env.control_timestep())
+    r = rollout(sc, "step:1V", t_env[-1], sample_interval=env.control_timestep(), engine="loop")
     np.testing.assert_allclose(r.time, t_env, atol=1e-12)
     np.testing.assert_allclose(r.tip_curvature, k_env, rtol=1e-9, atol=1e-9)
 

@@ -47,8 +47,11 @@ def test_threaded_equals_loop(actuator, representation, voltage, duration, param
 
 
 def test_auto_picks_threaded_only_where_it_applies():
-    assert rollout(Scene("pzt-hamr-small"), "step:120V", 1e-3).meta["engine"] == "threaded"
-    assert rollout(Scene("pedot-micro"), "step:1V", 0.05).meta["engine"] == "loop"
+    """auto: the drive compiled into the model where it has a native form (mjeap.native),
+    else threaded where it is open-loop, else the loop."""
+    assert rollout(Scene("pzt-hamr-small"), "step:120V", 1e-3).meta["engine"] == "native"
+    assert rollout(Scene("pzt-hamr-small", representation="cable"), "step:120V", 2e-4).meta["engine"] == "threaded"
+    assert rollout(Scene("pedot-micro", representation="cable"), "step:1V", 0.01).meta["engine"] == "loop"
 
 
 @pytest.mark.parametrize("actuator,params,words", [

@@ -113,6 +113,8 @@ class Drive:
 
     def __init__(self, scene, **params):
         self.scene = scene
+        # the actuator the drive acts on: a Scene's one part, or a part of a System
+        self.part = getattr(scene, "part", scene)
         defaults = self.PARAMETERS.get(scene.actuator.id, self.GENERIC_PARAMETERS)
         self.params = {k: v[0] for k, v in defaults.items()}
         self.sources = {k: f"{v[1]}; {v[2]}" for k, v in defaults.items()}
@@ -189,6 +191,38 @@ class Drive:
 
     def _restore_before(self, k: int) -> None:
         """Set the drive's own state to what it is before step ``k`` (none by default)."""
+
+    # -- native form: the drive as MuJoCo elements (mjeap.native) -------------------------
+    def native_reason(self) -> Optional[str]:
+        """None where the drive has a native MJCF form (:meth:`add_native`); else why not."""
+        return f"the {self.name} drive declares no native MJCF form"
+
+    def add_native(self, spec, joints, parent: str):
+        """Add the drive to ``spec`` (the scene's, internal units) as MuJoCo elements acting
+        on the hinge ``joints``; relaxation bodies go under body ``parent``. Returns the
+        :class:`mjeap.native.NativeHandles`."""
+        raise NotImplementedError(self.native_reason())
+
+    def native_reset(self, part, handles, prefix: str = "") -> None:
+        """Set the native model's drive state at rest at the part's present shape (after
+        the beam was reset and bent); the activation is zero after mj_resetData."""
+
+    def native_prepare(self, v_steps: np.ndarray) -> None:
+        """Before a native run with the voltages ``v_steps`` (V) held over the steps, so that
+        :meth:`native_signals` can read the drive's signals at any step."""
+        self.open_loop_moments(v_steps)
+
+    def native_signals(self, k: int, part, handles, prefix: str = "") -> Dict[str, float]:
+        """The drive's signals after step ``k`` of a native run, the part holding that
+        state: by default the loop drive replayed to step k (:meth:`seek`)."""
+        self.seek(k)
+        return self.signals()
+
+    def native_leave(self, k: int, part, handles, prefix: str = "") -> None:
+        """After a native run of ``k`` steps whose final state ``part`` holds: take over that
+        state and apply the last step's moments to the drive's own part (the scene), as the
+        loop leaves them; by default the loop drive replayed to step k."""
+        self.seek(k)
 
     def describe(self) -> str:
         return f"{self.name} ({self.model_used})" if self.model_used else self.name

@@ -62,18 +62,32 @@ class BlockingForceDrive(Drive):
 
     def reset(self, initial_curvature: float = 0.0) -> None:
         self.force.x[:] = 0.0
-        self.scene.set_bending_stiffness_scale(1.0)
+        self.part.set_bending_stiffness_scale(1.0)
         self._moment = 0.0
-        self.scene.set_internal_moments(0.0)
+        self.part.set_internal_moments(0.0)
 
     def step(self, voltage: float, dt: float) -> None:
-        self.scene.set_bending_stiffness_scale(self.stiffness(voltage))
+        self.part.set_bending_stiffness_scale(self.stiffness(voltage))
         self._moment = 2.0 / 3.0 * float(self.force.x[0, 0]) * self.L
-        self.scene.set_internal_moments(self._moment)
+        self.part.set_internal_moments(self._moment)
         self.force.advance(voltage)
 
     def closed_loop_reason(self):
         return "its stiffness table changes the beam's stiffness with the voltage" if self.stiffness.v.size else None
+
+    # -- native form: a first-order (filterexact) actuator on the bending tendon --------
+    def native_reason(self):
+        return self.closed_loop_reason()
+
+    def add_native(self, spec, joints, parent):
+        """M = (2/3) L F_1 a with the activation a the voltage low-passed over tau."""
+        from .. import native
+        u = self.scene.units
+        F1, tau = float(self.params["blocking_force_per_volt"]), float(self.params["time_constant"])
+        native.add_bending_tendon(spec, joints, np.ones(len(joints)))
+        native.add_drive_actuator(spec, 2.0 / 3.0 * self.L * F1 / u.moment, self.voltage_range(),
+                                  time_constant=tau / u.time)
+        return native.NativeHandles()
 
     def _moment_history(self, v):
         """The first-order force by scipy.signal.lfilter of the same exact (ZOH) recursion
@@ -88,7 +102,7 @@ class BlockingForceDrive(Drive):
 
     def signals(self) -> Dict[str, float]:
         return {"blocking_force (N)": float(self.force.x[0, 0]), "drive_moment (N m)": float(self._moment),
-                "stiffness_factor (-)": float(self.scene._stiffness_scale)}
+                "stiffness_factor (-)": float(self.part._stiffness_scale)}
 
     def reference_curvature(self, t, v, initial_curvature=0.0):
         """Quasi-static: uniform curvature (2/3) F_B L / (f(V) EI), F_B by scipy lsim

@@ -94,13 +94,18 @@ class ElectrostrictiveDrive(Drive):
         return 1.0 if self.factors is None else float(np.interp(abs(field), FIELDS, self.factors))
 
     def reset(self, initial_curvature: float = 0.0) -> None:
-        self.scene.set_bending_stiffness_scale(1.0)
-        self.scene.set_internal_moments(0.0)
+        self.part.set_bending_stiffness_scale(1.0)
+        self.part.set_internal_moments(0.0)
         self._v_last = None
         self._E = self._M = 0.0
 
     def closed_loop_reason(self):
         return None if self.factors is None else "field stiffening changes the beam's stiffness with the voltage"
+
+    def native_reason(self):
+        return ("its moment is quadratic in the voltage and a MuJoCo actuator's force is linear in ctrl: a native "
+                "form would need ctrl = V^2 and break the convention that ctrl is the voltage in volts (the "
+                "threaded engine runs it in C without Python per step)")
 
     def _moment_history(self, v):
         return np.repeat((self._M_per_V2 * v ** 2)[:, None], self.scene.layout.segments, axis=1)
@@ -111,12 +116,12 @@ class ElectrostrictiveDrive(Drive):
             self._M = self._M_per_V2 * voltage * voltage
             self._f = self.stiffness_factor(self._E)
             self._v_last = voltage
-        self.scene.set_bending_stiffness_scale(self._f)
-        self.scene.set_internal_moments(self._M)
+        self.part.set_bending_stiffness_scale(self._f)
+        self.part.set_internal_moments(self._M)
 
     def signals(self) -> Dict[str, float]:
         return {"field (V/m)": float(self._E), "drive_moment (N m)": float(self._M),
-                "stiffness_factor (-)": float(self.scene._stiffness_scale)}
+                "stiffness_factor (-)": float(self.part._stiffness_scale)}
 
     def reference_curvature(self, t, v, initial_curvature=0.0):
         """Quasi-static uniform curvature M(V) / (f(E) EI) of the continuum beam."""

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 from typing import Dict
 
+import mujoco
 import numpy as np
 
 from ..errors import ParameterError
@@ -70,17 +71,36 @@ class PiezoBimorphDrive(Drive):
         self._v_prev = None
         self._v = self.rest_voltage()
         self._dv = 0.0
-        self.scene.set_internal_moments(0.0)
+        self.part.set_internal_moments(0.0)
         self._m[:] = 0.0                        # per-hinge moment, N m, written in place
 
     def step(self, voltage: float, dt: float) -> None:
         np.multiply(self.gamma, voltage - 0.5 * self.params["bias"], out=self._m)
-        self.scene.set_internal_moments(self._m)
+        self.part.set_internal_moments(self._m)
         self._dv = 0.0 if self._v_prev is None else (voltage - self._v_prev) / dt
         self._v = self._v_prev = voltage
 
     def closed_loop_reason(self):
         return None
+
+    # -- native form: a fixed-gain actuator on the bending tendon -------------------------
+    def native_reason(self):
+        return None
+
+    def add_native(self, spec, joints, parent):
+        """M_j = Gamma_j (V - V_bias/2): tendon coefficients Gamma_j / Gamma_0 (the width
+        ratios), gain Gamma_0 and bias -Gamma_0 V_bias / 2; a tendon-velocity sensor
+        ``bend_rate`` gives the motional current Gamma_0 x its reading (the custom numeric
+        ``mjeap_coupling`` holds Gamma_0 in N m/V, i.e. A s)."""
+        from .. import native
+        u = self.scene.units
+        g0 = float(self.gamma[0])
+        native.add_bending_tendon(spec, joints, self.gamma / g0)
+        native.add_drive_actuator(spec, g0 / u.moment, self.voltage_range(), bias=-g0 * self.rest_voltage() / u.moment)
+        spec.add_sensor(name="bend_rate", type=mujoco.mjtSensor.mjSENS_TENDONVEL, objtype=mujoco.mjtObj.mjOBJ_TENDON,
+                        objname=native.TENDON)
+        spec.add_numeric(name="mjeap_coupling", data=[g0])
+        return native.NativeHandles(sensors={"motional_rate": "bend_rate"})
 
     def _moment_history(self, v):
         return np.multiply.outer(v - 0.5 * self.params["bias"], self.gamma)
@@ -94,7 +114,7 @@ class PiezoBimorphDrive(Drive):
         (what a sampled dV/dt sees) and the hinge rates now."""
         vb = self.params["bias"]
         return ((2 * self._v - vb) / (2 * self.params["resistance"]), self.params["capacitance"] * self._dv,
-                float(self.gamma @ self.scene.hinge_rates()))
+                float(self.gamma @ self.part.hinge_rates()))
 
     def signals(self) -> Dict[str, float]:
         i_r, i_c, i_m = self.currents()

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 from typing import Dict
 
+import mujoco
 import numpy as np
 from scipy import signal
 
@@ -65,7 +66,7 @@ class RCRelaxationDrive(Drive):
         """Start at rest at the scene's current shape: the relaxation state holds it (zero
         elastic moment beyond what gravity needs), so a bent start decays on the mechanical
         pole alone, as the zero-input term of seed 000's eq. (7)."""
-        sc = self.scene
+        sc = self.part
         # equilibrium at rest: k (theta - r) = gravity moment on each hinge
         self._r[:] = sc.hinge_angles() - sc.gravity_moments() / sc.hinge_stiffness()
         self._s[-1] = 0.0
@@ -78,12 +79,12 @@ class RCRelaxationDrive(Drive):
         self._m_drive = self.gamma * float(self._s[-1])
         np.multiply(self._k, self._r, out=self._m_relax)
         np.add(self._m_relax, self._m_drive, out=self._m_total)
-        self.scene.set_internal_moments(self._m_total)
+        self.part.set_internal_moments(self._m_total)
 
     def step(self, voltage: float, dt: float) -> None:
         self._v = voltage
         self._apply()
-        self.scene.hinge_angles(out=self._theta)
+        self.part.hinge_angles(out=self._theta)
         self._u[-1] = voltage
         np.multiply(self._b, self._u, out=self._bu)
         self._s *= self._a
@@ -96,6 +97,69 @@ class RCRelaxationDrive(Drive):
                 "current (A)": C * self.params["pole_electrical"] * (self._v - vc),
                 "drive_moment (N m)": float(self._m_drive),
                 "relaxation_moment_mean (N m)": float(np.mean(self._m_relax))}
+
+    # -- native form: filterexact actuator on the bending tendon + Maxwell arms ----------
+    def native_reason(self):
+        return None
+
+    def _internal_rates(self):
+        t = self.scene.units.time
+        p = self.params
+        return p["zero"] * t, p["pole_mechanical"] * t, p["pole_electrical"] * t
+
+    def add_native(self, spec, joints, parent):
+        from .. import native
+        u = self.scene.units
+        z, pm, pe = self._internal_rates()
+        native.add_bending_tendon(spec, joints, np.ones(len(joints)))
+        native.add_drive_actuator(spec, self.gamma / u.moment, self.voltage_range(), time_constant=1.0 / pe)
+        k = self.scene.layout.hinge_stiffness / u.rotational_stiffness
+        relax = native.add_maxwell_arms(spec, joints, parent, k, z, pm, self.scene.timestep / u.time,
+                                        float(self.scene.layout.link_mass.min() / u.mass))
+        return native.NativeHandles(relaxation_joints=relax)
+
+    def _relaxation_adr(self, part, handles, prefix):
+        m = part.model
+        ids = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, prefix + j) for j in handles.relaxation_joints]
+        a = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, prefix + handles.actuator)
+        return m.jnt_qposadr[ids], m.actuator_actadr[a]
+
+    def native_reset(self, part, handles, prefix=""):
+        """The Maxwell arms hold the present shape at rest: k_inf theta + k1 (theta - r) = g
+        on every hinge (g the gravity moment), the native twin of :meth:`reset`."""
+        u = self.scene.units
+        z, pm, _ = self._internal_rates()
+        k = part.hinge_stiffness() / u.rotational_stiffness
+        k1, k_inf = k * (z - pm) / z, k * pm / z
+        theta = part.hinge_angles()
+        g = part.gravity_moments() / u.moment
+        qadr, _ = self._relaxation_adr(part, handles, prefix)
+        part.data.qpos[qadr] = theta - (g - k_inf * theta) / k1
+        mujoco.mj_forward(part.model, part.data)
+
+    def native_prepare(self, v_steps):
+        self._v_native = np.asarray(v_steps, dtype=float)
+
+    def native_signals(self, k, part, handles, prefix=""):
+        """From the native state: v_c is the activation, the relaxation moment k1 r_j of
+        each arm (k r of the loop drive's internal variable), both after step k."""
+        u = self.scene.units
+        z, pm, _ = self._internal_rates()
+        qadr, aadr = self._relaxation_adr(part, handles, prefix)
+        self._s[-1] = part.data.act[aadr]
+        self._v = float(self._v_native[max(k - 1, 0)]) if k else 0.0
+        self._m_drive = self.gamma * float(self._s[-1])
+        k1 = part.hinge_stiffness() * (z - pm) / z
+        np.multiply(k1, part.data.qpos[qadr], out=self._m_relax)
+        return self.signals()
+
+    def native_leave(self, k, part, handles, prefix=""):
+        """The loop drive's state from the native one (v_c, r = k1 r_native / k), its
+        moments applied to the scene: a loop run can go on from here."""
+        self.native_signals(k, part, handles, prefix)
+        self._k = self.part.hinge_stiffness()
+        np.divide(self._m_relax, self._k, out=self._r)
+        self._apply()
 
     def closed_loop_reason(self):
         return "the back-relaxation acts on every moment the beam carries, so the moments follow the hinge angles"

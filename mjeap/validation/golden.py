@@ -30,14 +30,19 @@ SCENARIOS: Dict[str, Tuple[dict, str, float, float, dict]] = {
 }
 
 
-def simulate(actuator_id: str) -> Tuple[np.ndarray, np.ndarray]:
-    """(time s, tip curvature 1/m) of the actuator's scenario, SAMPLES + 1 samples."""
+#: where the golden files live
+FOLDER = Path(__file__).resolve().parents[2] / "tests" / "golden"
+
+
+def simulate(actuator_id: str, engine: str = "loop") -> Tuple[np.ndarray, np.ndarray]:
+    """(time s, tip curvature 1/m) of the actuator's scenario, SAMPLES + 1 samples, on the
+    lockstep loop (the reference every other engine is tested against) or ``engine``."""
     from ..rollout import rollout
     from ..scene import Scene
     kw, wave, duration, k0, params = SCENARIOS[actuator_id]
     scene = Scene(actuator_id, **kw)
     r = rollout(scene, wave, duration, drive_params=params, initial_curvature=k0, progress=False,
-                sample_interval=duration / SAMPLES)
+                sample_interval=duration / SAMPLES, engine=engine)
     return r.time, r.tip_curvature
 
 

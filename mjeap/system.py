@@ -1,0 +1,490 @@
+"""Actuators as MuJoCo components: attach them to any model and run several in one system
+with other bodies and contact.
+
+:func:`attach` places a catalog (or user) actuator, with its drive compiled in
+(:mod:`mjeap.native`), into a user's ``MjSpec`` at a site, body or frame, under a prefix.
+Its beam is discretised, damped and given a timestep exactly as a one-actuator
+:class:`~mjeap.Scene` in the same orientation (its *twin*, built with the mount's world
+rotation at the host's ``qpos0``), so an attached actuator moves as its Scene does.
+
+:class:`System` compiles the host with its attached actuators: the timestep is the
+smallest of the actuators' own choices (each already below its stability limit), contact
+parameters are set for micro scale (:class:`ContactParameters`), and the model declares its
+units in ``mjeap_units``. Each actuator is an :class:`~mjeap.component.ActuatorPart` with
+SI read-outs in its own clamp frame; rollouts take one voltage per actuator.
+
+Units: the host is written in the internal units the caller declares (``units``, default
+mjeap's mm, mg, ms); a host in SI is refused where a beam's segments would fall below
+MuJoCo's 1e-15 floors, with the part named and a unit system that works.
+"""
+from __future__ import annotations
+
+import re
+import time as _time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Dict, List, Optional, Sequence, Union
+
+import mujoco
+import numpy as np
+
+from . import native
+from .component import ActuatorPart
+from .errors import DivergenceError, ParameterError, UnknownNameError, check_positive
+from .scene import DEFAULT_SEGMENTS, INTEGRATORS, Scene
+from .units import DEFAULT_UNITS, UnitSystem
+
+_PREFIX = re.compile(r"^[A-Za-z][A-Za-z0-9_-]*$")
+
+
+@dataclass(frozen=True)
+class ContactParameters:
+    """Contact for micro-scale systems, applied to every contact of the system (MuJoCo's
+    ``override`` flag), internal units derived from the timestep h.
+
+    * ``solref`` = (``timeconst_steps`` x h, ``dampratio``): the stiffest contact MuJoCo
+      integrates stably is a time constant of 2 h (it raises smaller ones to 2 h);
+      critically damped, so a beam closing on a body does not bounce.
+    * ``solimp`` = (0.99, 0.999, ``width_fraction`` x the thinnest beam, 0.5, 2): impedance
+      near 1 makes the contact nearly rigid. At rest the penetration is
+      F (1 - d) (timeconst)^2 / m_eff for a force F on an effective mass m_eff; for the
+      actuators here that is far below their thickness (tested: a beam pressing on a block).
+    * ``margin`` 0, ``friction`` (sliding, torsional, rolling) = (0.5, 0.005, 0.0001), an
+      elliptic cone (``cone``), condim 3 on the beam's geoms.
+    """
+
+    timeconst_steps: float = 2.0
+    dampratio: float = 1.0
+    impedance: tuple = (0.99, 0.999)
+    width_fraction: float = 0.1
+    friction: tuple = (0.5, 0.005, 0.0001)
+    margin: float = 0.0
+    cone: str = "elliptic"
+
+    def apply(self, spec: mujoco.MjSpec, h: float, thickness: float) -> None:
+        o = spec.option
+        o.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
+        o.enableflags |= int(mujoco.mjtEnableBit.mjENBL_OVERRIDE)
+        o.o_solref = [self.timeconst_steps * h, self.dampratio]
+        o.o_solimp = [self.impedance[0], self.impedance[1], self.width_fraction * thickness, 0.5, 2.0]
+        o.o_margin = self.margin
+        o.o_friction = [self.friction[0], self.friction[0], self.friction[1], self.friction[2], self.friction[2]]
+        o.cone = {"elliptic": mujoco.mjtCone.mjCONE_ELLIPTIC, "pyramidal": mujoco.mjtCone.mjCONE_PYRAMIDAL}[self.cone]
+
+
+@dataclass
+class AttachedActuator:
+    """What :func:`attach` placed into a host spec. Names in the compiled model are
+    ``prefix`` + the Scene's names (``clamp``, ``link<j>``, ``hinge<j>``, ``tip``) and, for
+    the drive, ``drive`` (actuator; ctrl in volts), ``bend`` (tendon)."""
+
+    prefix: str                      # with its trailing '/'
+    twin: Scene                      # the equivalent one-actuator Scene (layout, damping, timestep)
+    drive: Optional[object]          # the drive (its native form is in the model), None if passive
+    native: Optional[native.NativeHandles]
+    contact: bool
+
+    def name(self, element: str) -> str:
+        return self.prefix + element
+
+    @property
+    def actuator_name(self) -> Optional[str]:
+        return None if self.native is None else self.prefix + self.native.actuator
+
+    @property
+    def tip_site(self) -> str:
+        return self.prefix + self.twin.handles.tip_site
+
+    @property
+    def joints(self) -> List[str]:
+        return [self.prefix + j for j in self.twin.handles.joints]
+
+    @property
+    def tendon(self) -> Optional[str]:
+        return None if self.native is None else self.prefix + self.native.tendon
+
+
+def _mount(spec: mujoco.MjSpec, site, body, frame):
+    given = [(k, v) for k, v in (("site", site), ("body", body), ("frame", frame)) if v is not None]
+    if len(given) != 1:
+        raise ParameterError("site/body/frame", ", ".join(k for k, _ in given) or "none",
+                             "exactly one of site=, body= or frame= naming where the clamp goes")
+    kind, name = given[0]
+    el = getattr(spec, kind)(name)
+    if el is None:
+        known = [x.name for x in getattr(spec, {"site": "sites", "body": "bodies", "frame": "frames"}[kind]) if x.name]
+        raise UnknownNameError(kind, str(name), known)
+    return kind, name, el
+
+
+def _mount_rotation(spec: mujoco.MjSpec, kind: str, name: str, el) -> tuple:
+    """World rotation of the mount at the host's qpos0 and the host's gravity (internal)."""
+    m = spec.copy().compile()
+    d = mujoco.MjData(m)
+    mujoco.mj_kinematics(m, d)
+    if kind == "site":
+        R = d.site_xmat[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, name)].reshape(3, 3)
+    else:
+        parent = el.name if kind == "body" else el.parent.name
+        R = d.xmat[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, parent)].reshape(3, 3)
+        if kind == "frame":
+            q = np.zeros(9)
+            mujoco.mju_quat2Mat(q, np.asarray(el.quat, dtype=float) / np.linalg.norm(el.quat))
+            R = R @ q.reshape(3, 3)
+    return R.copy(), m.opt.gravity.copy()
+
+
+def attach(spec: mujoco.MjSpec, actuator, *, prefix: str, site: Optional[str] = None, body: Optional[str] = None,
+           frame: Optional[str] = None, drive: Optional[str] = None, drive_params: Optional[dict] = None,
+           payload=None, representation: str = "hinge", segments: int = DEFAULT_SEGMENTS,
+           units: Optional[UnitSystem] = None, damping_ratio: Optional[float] = None, contact: bool = True,
+           passive: bool = False, integrator: Optional[str] = None) -> AttachedActuator:
+    """Place ``actuator`` (catalog id or :class:`mjeap.Actuator`) into the host ``spec`` at a
+    ``site``, ``body`` or ``frame`` (exactly one, by name): its clamp frame is the mount's
+    (x along the beam, y the deflection, z the hinge axis). ``prefix`` (letters, digits,
+    '_', '-'; unique in the spec) is prepended as ``prefix/`` to every name. ``drive``
+    (default: the actuator's own) is compiled in (:mod:`mjeap.native`); ``passive=True``
+    attaches the bare beam (the cable representation has no native drive). ``contact``
+    lets the beam's geoms touch other bodies. ``units``: the host's internal units.
+    ``integrator`` defaults to 'discrete' with contact (MuJoCo solves contacts in the
+    metric of its implicit update there; under 'implicitfast' contact impulses are sized
+    for M alone and kick the heavily damped short modes of a beam: tested) and
+    'implicitfast' without; the timestep and damping follow from it (:mod:`mjeap.scene`)."""
+    units = units or DEFAULT_UNITS
+    integrator = integrator or ("discrete" if contact else "implicitfast")
+    if not isinstance(prefix, str) or not _PREFIX.match(prefix):
+        raise ParameterError("prefix", prefix, "a name of letters, digits, '_' or '-', starting with a letter")
+    if spec.body(prefix + "/clamp") is not None:
+        raise ParameterError("prefix", prefix, "a prefix not used yet in this model (an actuator is attached "
+                             f"under '{prefix}/' already)")
+    kind, name, el = _mount(spec, site, body, frame)
+    R, g = _mount_rotation(spec, kind, name, el)
+    twin = Scene(actuator, representation=representation, segments=segments, orientation=R, payload=payload,
+                 units=units, damping_ratio=damping_ratio, gravity=bool(np.any(g)), integrator=integrator)
+    gs = g * units.acceleration
+    if np.any(g) and not np.allclose(gs, [0, 0, -9.80665], rtol=2e-3):
+        raise ParameterError("spec.option.gravity", f"{gs} m/s^2 (in the declared units {units.describe()})",
+                             f"standard gravity along -z, 0 0 {-9.80665 / units.acceleration:.9g} in these units "
+                             "(9.81 m/s^2), or none: the actuator's damping and timestep are chosen for it "
+                             "(a host in other units: declare them with units=)")
+    drv, nat = None, None
+    if passive:
+        child = twin.spec.copy()
+    else:
+        from .drives import make_drive
+        drv = make_drive(drive, twin, **(drive_params or {}))
+        why = native.why_not(twin, drv)
+        if why is not None:
+            raise ParameterError("drive", drv.name, "a drive with a native form, or passive=True", why)
+        nm = twin.native_model(drv)
+        child, nat = nm.spec.copy(), nm.handles
+    for n in list(child.numerics):
+        if n.name == native.UNITS_FIELD:
+            child.delete(n)
+    if contact:
+        for j in range(twin.layout.segments):
+            g_ = child.geom(f"link{j}")
+            g_.contype, g_.conaffinity, g_.condim = 1, 1, 3
+        if twin.payload is not None:
+            child.geom("payload").contype, child.geom("payload").conaffinity = 1, 1
+    o, co = spec.option, child.option         # the host's options rule; say so to MjSpec
+    co.timestep, co.integrator, co.gravity = o.timestep, o.integrator, o.gravity
+    child.memory = spec.memory
+    clamp = child.body(twin.handles.clamp_body)
+    clamp.pos, clamp.quat = [0, 0, 0], [1, 0, 0, 0]       # the mount's frame is the clamp frame
+    target = el if kind != "body" else el.add_frame()
+    target.attach_body(clamp, prefix + "/", "")
+    return AttachedActuator(prefix + "/", twin, drv, nat, contact)
+
+
+@dataclass
+class SystemResult:
+    """A system rollout, SI: one :class:`~mjeap.rollout.RolloutResult` per actuator (by
+    prefix, positions in its own clamp frame) and every body's world pose per sample."""
+
+    time: np.ndarray                                  # (n,) s
+    actuators: Dict[str, object]                      # prefix -> RolloutResult
+    body_names: List[str]
+    body_position: np.ndarray                         # (n, nbody, 3) m, world
+    body_quat: np.ndarray                             # (n, nbody, 4) world (w x y z)
+    contact_force: np.ndarray                         # (n, nbody, 3) N, net contact force on each body, world
+    meta: dict = field(default_factory=dict)
+
+    def body(self, name: str) -> int:
+        try:
+            return self.body_names.index(name)
+        except ValueError:
+            raise UnknownNameError("body", name, self.body_names) from None
+
+
+class System:
+    """A compiled MuJoCo system: a host ``spec`` with ``actuators`` attached by
+    :func:`attach` (all in ``units``), other bodies, joints, constraints and contact.
+    ``timestep`` (s) defaults to the smallest of the actuators' own choices; a larger one is
+    refused with the limit. The integrator is the actuators' (they were attached for one:
+    'discrete' with contact, see :func:`attach`); ``integrator`` is needed only without
+    actuators. ``contact``: :class:`ContactParameters` (None: the host's own)."""
+
+    def __init__(self, spec: mujoco.MjSpec, actuators: Sequence[AttachedActuator], units: Optional[UnitSystem] = None,
+                 timestep: Optional[float] = None, integrator: Optional[str] = None,
+                 contact: Optional[ContactParameters] = ContactParameters()):
+        self.units = units = units or DEFAULT_UNITS
+        self.actuators = list(actuators)
+        prefixes = [a.prefix for a in self.actuators]
+        if len(set(prefixes)) != len(prefixes):
+            raise ParameterError("actuators", prefixes, "actuators with distinct prefixes")
+        for a in self.actuators:
+            if a.twin.units != units:
+                raise ParameterError("units", units.describe(), f"the units actuator '{a.prefix}' was attached in "
+                                     f"({a.twin.units.describe()}): pass the same units= to attach and System")
+        used = {a.twin.integrator for a in self.actuators}
+        if len(used) > 1 or (integrator is not None and used and used != {integrator}):
+            raise ParameterError("integrator", integrator or sorted(used), "one integrator for every actuator "
+                                 f"(attached with {', '.join(f'{a.prefix} {a.twin.integrator}' for a in self.actuators)}): "
+                                 "pass the same integrator= (or contact=) to attach")
+        integrator = integrator or (used.pop() if used else "implicitfast")
+        if integrator not in INTEGRATORS:
+            raise ParameterError("integrator", integrator, f"one of {', '.join(INTEGRATORS)}")
+        self.integrator = integrator
+        h_limit = min((a.twin.choice.stability_limit for a in self.actuators), default=np.inf)
+        if timestep is None:
+            if not self.actuators:
+                raise ParameterError("timestep", None, "a timestep in s for a system without actuators")
+            h = min(a.twin.timestep for a in self.actuators)
+            self.timestep_reason = "the smallest of the actuators' own timesteps"
+        else:
+            h = check_positive("timestep", timestep, "s")
+            if h > h_limit:
+                raise ParameterError("timestep", timestep, f"a timestep <= {h_limit:.4g} s",
+                                     "the stability limit of the stiffest attached actuator")
+            self.timestep_reason = "given by the user"
+        self.spec = spec
+        spec.option.timestep = h / units.time
+        spec.option.integrator = INTEGRATORS[integrator]
+        spec.option.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_AUTORESET)
+        if contact is not None and any(a.contact for a in self.actuators):
+            t_min = min(a.twin.layout.thickness for a in self.actuators if a.contact) / units.length
+            contact.apply(spec, h / units.time, t_min)
+        self.contact = contact
+        native.add_units(spec, units)
+        try:
+            self.model = spec.compile()
+        except ValueError as e:
+            raise ParameterError("spec", spec.modelname, "a host model that compiles with its actuators",
+                                 str(e).splitlines()[0]) from None
+        self.data = mujoco.MjData(self.model)
+        m = self.model
+        self.parts: List[ActuatorPart] = []
+        self.actuator_ids: List[int] = []
+        for a in self.actuators:
+            tw = a.twin
+            clamp = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, a.prefix + tw.handles.clamp_body)
+            fixed = m.body_weldid[clamp] == 0          # welded to the world: a constant clamp frame
+            part = ActuatorPart(m, tw.handles, tw.layout, tw.actuator, units, tw.representation, tw.payload,
+                                prefix=a.prefix, rotation=None)
+            part.bind(self.data)
+            if fixed:
+                mujoco.mj_kinematics(m, self.data)
+                part._fixed_rotation = self.data.xmat[clamp].reshape(3, 3).copy()
+            self.parts.append(part)
+            self.actuator_ids.append(-1 if a.actuator_name is None else
+                                     mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, a.actuator_name))
+        self._step_count = 0
+        self.reset()
+
+    # ------------------------------------------------------------------ access
+    def __len__(self) -> int:
+        return len(self.actuators)
+
+    def index(self, prefix: str) -> int:
+        names = [a.prefix.rstrip("/") for a in self.actuators]
+        p = prefix.rstrip("/")
+        if p not in names:
+            raise UnknownNameError("actuator prefix", p, names)
+        return names.index(p)
+
+    def part(self, prefix: str) -> ActuatorPart:
+        """The actuator attached under ``prefix``: SI read-outs in its clamp frame."""
+        return self.parts[self.index(prefix)]
+
+    @property
+    def timestep(self) -> float:
+        return self.model.opt.timestep * self.units.time
+
+    @property
+    def time(self) -> float:
+        return self.data.time * self.units.time
+
+    # ------------------------------------------------------------------ state
+    def reset(self, initial_curvatures: Union[float, Sequence[float]] = 0.0) -> None:
+        """Reset to the host's qpos0 with each beam a uniform arc of its initial curvature
+        (1/m), the drives at rest there (relaxation holding the shape, no charge)."""
+        k0 = self._per_actuator("initial_curvatures", initial_curvatures)
+        m, d = self.model, self.data
+        mujoco.mj_resetData(m, d)
+        for p, k in zip(self.parts, k0):
+            p.apply_loads()
+            if k:
+                p.set_hinge_angles(np.full(p.layout.segments, float(k) * p.layout.ds), forward=False)
+        mujoco.mj_forward(m, d)
+        for a, p in zip(self.actuators, self.parts):
+            if a.drive is not None:
+                a.drive.native_reset(p, a.native, a.prefix)
+        for a, i in zip(self.actuators, self.actuator_ids):
+            if i >= 0:
+                d.ctrl[i] = a.drive.rest_voltage()
+        self._step_count = 0
+
+    def _per_actuator(self, name: str, values) -> list:
+        if np.ndim(values) == 0 and not isinstance(values, (str, dict)):
+            return [values] * len(self)
+        if isinstance(values, dict):
+            out = [None] * len(self)
+            for k, v in values.items():
+                out[self.index(k)] = v
+            return out
+        values = list(values)
+        if len(values) != len(self):
+            raise ParameterError(name, f"{len(values)} values", f"one per actuator ({len(self)}: "
+                                 f"{', '.join(a.prefix.rstrip('/') for a in self.actuators)}) or a dict by prefix")
+        return values
+
+    def set_voltages(self, voltages: Sequence[float]) -> None:
+        """Hold these voltages (V), one per actuator, from now on (the actuators' ctrl)."""
+        for a, i, v in zip(self.actuators, self.actuator_ids, self._per_actuator("voltages", voltages)):
+            if i < 0 or v is None:
+                continue
+            a.drive.check_voltage(np.asarray([v], dtype=float))
+            self.data.ctrl[i] = v
+
+    def step(self, n: int = 1) -> None:
+        """Advance ``n`` steps; raises :class:`DivergenceError` if the state blows up."""
+        mujoco.mj_step(self.model, self.data, nstep=n)
+        self._step_count += n
+        self.check_finite()
+        mujoco.mj_kinematics(self.model, self.data)
+
+    def check_finite(self) -> None:
+        d = self.data
+        bad = d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number > 0 or \
+            not np.isfinite(float(d.qpos.sum()) + float(d.qvel.sum()))
+        if bad:
+            raise DivergenceError(
+                f"system of {len(self)} actuators diverged by step {self._step_count} (t = {self.time:.6g} s): "
+                f"timestep {self.timestep:.4g} s ({self.timestep_reason}); check the host's bodies, joints and "
+                "contacts (a stiff or light part may need a smaller timestep)")
+
+    # ------------------------------------------------------------------ contact
+    def contact_forces(self) -> np.ndarray:
+        """Net contact force (N, world frame) on every body at the present state, (nbody, 3)."""
+        m, d = self.model, self.data
+        out = np.zeros((m.nbody, 3))
+        f6 = np.zeros(6)
+        for i in range(d.ncon):
+            c = d.contact[i]
+            mujoco.mj_contactForce(m, d, i, f6)
+            fw = c.frame.reshape(3, 3).T @ f6[:3]        # force of geom1 on geom2, world
+            out[m.geom_bodyid[c.geom2]] += fw
+            out[m.geom_bodyid[c.geom1]] -= fw
+        return out * self.units.force
+
+    def penetration(self) -> float:
+        """Deepest penetration (m) among the present contacts (0 if none)."""
+        d = self.data
+        dist = [d.contact[i].dist for i in range(d.ncon)]
+        return max(0.0, -min(dist, default=0.0)) * self.units.length
+
+    # ------------------------------------------------------------------ rollout
+    def rollout(self, voltages, duration: float, initial_curvatures: Union[float, Sequence[float]] = 0.0,
+                sample_interval: Optional[float] = None, rrd: Union[str, Path, None] = None,
+                on_sample=None) -> SystemResult:
+        """Run for ``duration`` s with one voltage per actuator (waveform text,
+        :class:`~mjeap.Waveform`, callable v(t) or None for its rest voltage; a list or a dict
+        by prefix). Returns a :class:`SystemResult`; with ``rrd`` a Rerun recording (written
+        also when the run fails: it then ends with the error). ``on_sample(system)`` is
+        called at every sample (e.g. to move a mocap body)."""
+        from .rollout import _Samples, _sample_steps, _voltage_steps, _waveform
+        duration = check_positive("duration", duration, "s")
+        waves = self._per_actuator("voltages", voltages)
+        dt = self.timestep
+        n_steps = max(1, int(round(duration / dt)))
+        v_steps = []
+        for a, w in zip(self.actuators, waves):
+            if a.drive is None:
+                if w is not None:
+                    raise ParameterError("voltages", w, f"None for the passive actuator '{a.prefix}'")
+                v_steps.append(None)
+                continue
+            wave = None if w is None else _waveform(w, duration)
+            v = _voltage_steps(wave, duration, dt, a.drive) if wave is not None else \
+                np.full(n_steps, a.drive.rest_voltage())
+            a.drive.check_voltage(v)
+            v_steps.append(v)
+        sample_steps = _sample_steps(n_steps, dt, sample_interval)
+        ns = len(sample_steps)
+        samples = [_Samples(p, ns) for p in self.parts]
+        nb = self.model.nbody
+        pos, quat, fc = np.empty((ns, nb, 3)), np.empty((ns, nb, 4)), np.empty((ns, nb, 3))
+        m, d = self.model, self.data
+        self.reset(initial_curvatures)
+        for a, v in zip(self.actuators, v_steps):
+            if v is not None:
+                a.drive.native_prepare(v)
+                a.drive.part = self.parts[self.actuators.index(a)]
+        active = [(i, v) for i, v in zip(self.actuator_ids, v_steps) if v is not None]
+        meta = {"actuators": {a.prefix.rstrip("/"): {"actuator": a.twin.actuator.id,
+                                                     "drive": None if a.drive is None else a.drive.describe(),
+                                                     "voltage": None if w is None else getattr(_waveform(w, duration), "text", str(w))}
+                              for a, w in zip(self.actuators, waves)},
+                "duration_s": duration, "steps": n_steps, "timestep_s": dt, "timestep_reason": self.timestep_reason,
+                "units": self.units.describe()}
+        ws = np.empty(m.nv)
+
+        def sample(i, k):
+            ws[:] = d.qacc_warmstart
+            mujoco.mj_forward(m, d)             # contacts and their forces at this state
+            d.qacc_warmstart[:] = ws
+            for a, p, smp, v in zip(self.actuators, self.parts, samples, v_steps):
+                sig = {} if a.drive is None else a.drive.native_signals(k, p, a.native, a.prefix)
+                smp.take(k * dt, np.nan if v is None else v[max(k - 1, 0)], sig)
+            pos[i] = d.xpos * self.units.length
+            quat[i] = d.xquat
+            fc[i] = self.contact_forces()
+            if on_sample is not None:
+                on_sample(self)
+
+        error = None
+        wall0 = _time.perf_counter()
+        try:
+            sample(0, 0)
+            nxt = 1
+            for k in range(n_steps):
+                for i, v in active:
+                    d.ctrl[i] = v[k]
+                mujoco.mj_step(m, d)
+                self._step_count = k + 1
+                if (k + 1) % 100 == 0 or (nxt < ns and k + 1 == sample_steps[nxt]):
+                    self.check_finite()
+                if nxt < ns and k + 1 == sample_steps[nxt]:
+                    sample(nxt, k + 1)
+                    nxt += 1
+        except BaseException as e:
+            error = e
+            raise
+        finally:
+            meta["wall_time_s"] = _time.perf_counter() - wall0
+            if error is not None:
+                meta["error"] = f"{type(error).__name__}: {error}"
+            n = samples[0].n if samples else 0
+            results = {}
+            for a, smp in zip(self.actuators, samples):
+                r = smp.result(a.drive, 0.0, dict(meta))
+                r.reference_curvature = None if a.drive is None else r.reference_curvature
+                results[a.prefix.rstrip("/")] = r
+            names = [mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b) or f"body{b}" for b in range(nb)]
+            res = SystemResult(samples[0].t[:n] if samples else np.zeros(0), results, names, pos[:n], quat[:n],
+                               fc[:n], meta)
+            if rrd is not None:
+                from .recording import write_system_recording
+                write_system_recording(rrd, res, self)
+        return res

@@ -1,0 +1,159 @@
+"""Actuators as MuJoCo components (mjeap.system): attached to a host model written here, several
+in one system, with contact.
+
+References: the equivalent one-actuator Scene (the same beam, damping and timestep; round-off
+apart the same trajectory), and for contact the discrete chain's own blocked force (the
+hinge chain's closed form, below) and the Euler-Bernoulli 3 M / (2 a)."""
+import mujoco
+import numpy as np
+import pytest
+
+from mjeap import Scene, UnitSystem, rollout
+from mjeap.errors import ParameterError, UnknownNameError
+from mjeap.system import System, attach
+
+G = "0 0 -0.00980665"      # standard gravity in mm / ms^2
+
+
+def host(body: str = "", extra: str = "", gravity: str = G) -> mujoco.MjSpec:
+    return mujoco.MjSpec.from_string(
+        f'<mujoco><option gravity="{gravity}"/><worldbody>{body}</worldbody>{extra}</mujoco>')
+
+
+TILTED = '<body name="base" pos="1 -2 3" quat="0.9 0.2 -0.1 0.3"><site name="mount" pos="0.5 0 0" quat="0.8 0.1 0.3 0.2"/></body>'
+
+
+@pytest.mark.parametrize("contact,integrator", [(False, "implicitfast"), (True, "discrete")])
+def test_attached_at_a_tilted_site_moves_as_its_scene(contact, integrator):
+    """At a site tilted in 3D (gravity then loads the beam in and out of its plane): the SI
+    tip curvature in the clamp frame equals the equivalent Scene's (same orientation
+    relative to gravity, same integrator) to 1e-6 of its largest value."""
+    spec = host(TILTED)
+    a = attach(spec, "pedot-micro", site="mount", prefix="left", payload="3.15mg@6.2mm", contact=contact)
+    s = System(spec, [a])
+    assert s.integrator == integrator
+    r = s.rollout(["square:1V@2Hz"], 0.5, initial_curvatures=[-50.0])
+    ref = rollout(Scene("pedot-micro", orientation=a.twin.rotation, payload="3.15mg@6.2mm", integrator=integrator),
+                  "square:1V@2Hz", 0.5, initial_curvature=-50.0)
+    k, k_ref = r.actuators["left"].tip_curvature, ref.tip_curvature
+    assert s.timestep == a.twin.timestep
+    assert np.max(np.abs(k - k_ref)) <= 1e-6 * np.abs(k_ref).max()
+    np.testing.assert_allclose(r.actuators["left"].tip_position, ref.tip_position, rtol=0,
+                               atol=1e-6 * np.abs(ref.tip_position).max())
+
+
+TWO = ('<body name="base"><site name="a" pos="0 0 0" quat="0.7071068 0.7071068 0 0"/>'
+       '<site name="b" pos="0 30 0" quat="0.7071068 0.7071068 0 0"/></body>')
+
+
+def test_two_actuators_not_touching_each_move_as_alone():
+    """Two actuators whose bending planes are vertical (gravity bends them): one driven, one
+    at 0 V (sagging and creeping under its own weight). Each equals its one-actuator run
+    to 1e-9 of its swing."""
+    spec = host(TWO)
+    a = attach(spec, "pedot-micro", site="a", prefix="driven")
+    b = attach(spec, "pedot-micro", site="b", prefix="idle")
+    s = System(spec, [a, b])
+    r = s.rollout({"driven": "square:1V@2Hz", "idle": None}, 0.5)
+    for name, att, wave in (("driven", a, "square:1V@2Hz"), ("idle", b, "step:0V")):
+        alone = rollout(Scene("pedot-micro", orientation=att.twin.rotation, integrator="discrete"), wave, 0.5)
+        k = r.actuators[name].tip_curvature
+        assert np.ptp(alone.tip_curvature) > 0
+        assert np.max(np.abs(k - alone.tip_curvature)) <= 1e-9 * np.ptp(alone.tip_curvature), name
+
+
+def chain_blocked_force(part, moments, a: float) -> float:
+    """The hinge chain's blocked force (N) at distance a (m) from the clamp, zero gap: hinge j
+    at x_j < a turns by (M_j - F (a - x_j)) / k_j, and the point at a does not move:
+    F = sum M_j (a - x_j) / k_j / sum (a - x_j)^2 / k_j."""
+    x = part.layout.hinge_x
+    k = part.hinge_stiffness()
+    arm = np.clip(a - x, 0.0, None)
+    return float(np.sum(moments * arm / k) / np.sum(arm**2 / k))
+
+
+def test_beam_pressing_on_a_block_gives_its_blocked_force():
+    """pedot-micro, horizontal, a fixed rod (capsule along the hinge axis) touching the beam's
+    +y face at a = 5 mm; 3 V. The contact force follows the chain's blocked force for the
+    drive's moment Gamma v_c (v_c the actuator's activation) within 1 %, and the
+    Euler-Bernoulli 3 M / (2 a) within 2 % (the 20-hinge chain's discretisation). The
+    penetration stays below 1 % of the beam's 35 um."""
+    t, r, a_mm = 35e-3, 0.2, 5.0
+    rod = f'<geom name="rod" type="capsule" size="{r} 1" pos="{a_mm} {t / 2 + r} 0" rgba="0.6 0.6 0.6 1"/>'
+    spec = host('<site name="mount"/>' + rod)
+    act = attach(spec, "pedot-micro", site="mount", prefix="beam")
+    s = System(spec, [act])
+    s.set_voltages([3.0])
+    s.step(int(round(0.3 / s.timestep)))
+    mujoco.mj_forward(s.model, s.data)
+    part, drv = s.parts[0], act.drive
+    vc = s.data.act[s.model.actuator_actadr[s.actuator_ids[0]]]
+    M = drv.gamma * vc
+    F = np.linalg.norm(s.contact_forces()[0])                      # on the world body (the rod)
+    assert F == pytest.approx(chain_blocked_force(part, M, a_mm * 1e-3), rel=0.01)
+    assert F == pytest.approx(1.5 * M / (a_mm * 1e-3), rel=0.02)
+    assert s.penetration() < 0.01 * t * 1e-3
+
+
+# a polystyrene bead (1.05 g/cm^3) of radius 0.8 mm, wider than the fingers (1.37 mm), on a
+# floor; the fingers' faces 0.2 mm from it
+GRIP = ('<site name="left" pos="0 -1.0175 0"/>'
+        '<site name="right" pos="0 1.0175 0" quat="0 1 0 0"/>'
+        '<geom name="floor" type="box" size="10 10 0.1" pos="4 0 -0.9" rgba="0.8 0.8 0.8 1"/>'
+        '<body name="bead" pos="5 0 0"><freejoint/>'
+        '<geom name="bead" type="sphere" size="0.8" mass="2.25" rgba="0.9 0.7 0.1 1"/></body>')
+
+
+def test_two_actuators_close_on_a_free_body():
+    """Two pedot-micro fingers facing each other close on a 2.25 mg bead resting on a floor:
+    contact forces appear on the bead from both sides, each above 10 x its weight, equal
+    and opposite to 2 %, the bead stays centred (within 20 um) and nothing diverges;
+    penetration below 2 % of the beam thickness."""
+    spec = host(GRIP)
+    fingers = [attach(spec, "pedot-micro", site=n, prefix=n) for n in ("left", "right")]
+    s = System(spec, fingers)
+    r = s.rollout(["step:3V", "step:3V"], 0.6, sample_interval=0.01)
+    bead = r.body("bead")
+    f = r.contact_force[:, bead]
+    assert np.all(np.isfinite(r.body_position))
+    assert abs(r.body_position[-1, bead, 1]) < 20e-6
+    # squeezed from both sides: the fingers' forces along y cancel, each well above the weight
+    weight = 2.25e-6 * 9.80665
+    finger_forces = [np.sum([s.contact_forces()[b] for b in part.link_ids], axis=0) for part in s.parts]
+    assert abs(finger_forces[0][1]) > 10 * weight
+    assert finger_forces[0][1] == pytest.approx(-finger_forces[1][1], rel=0.02)
+    assert abs(f[-1, 1]) < 0.02 * abs(finger_forces[0][1])
+    assert s.penetration() < 0.02 * 35e-6
+
+
+def test_bad_attachments_are_named():
+    spec = host(TILTED)
+    with pytest.raises(UnknownNameError, match="site 'mnt'.*mount"):
+        attach(spec, "pedot-micro", site="mnt", prefix="a")
+    with pytest.raises(UnknownNameError, match="body"):
+        attach(spec, "pedot-micro", body="nobody", prefix="a")
+    with pytest.raises(ParameterError, match="site/body/frame"):
+        attach(spec, "pedot-micro", site="mount", body="base", prefix="a")
+    a = attach(spec, "pedot-micro", site="mount", prefix="a")
+    with pytest.raises(ParameterError, match="prefix"):
+        attach(spec, "pedot-micro", site="mount", prefix="a")
+    with pytest.raises(ParameterError, match="prefix"):
+        attach(spec, "pedot-micro", site="mount", prefix="a/b")
+    s = System(spec, [a])
+    with pytest.raises(ParameterError, match="voltages.*one per actuator"):
+        s.rollout(["step:1V", "step:1V"], 0.01)
+    with pytest.raises(ParameterError, match="voltage"):
+        s.rollout(["step:9V"], 0.01)
+    with pytest.raises(ParameterError, match="drive"):
+        attach(host(TILTED), "pvdf-60", site="mount", prefix="p")
+
+
+def test_si_host_with_micro_parts_is_refused_with_a_unit_system_that_works():
+    spec = host('<site name="mount"/>', gravity="0 0 -9.80665")
+    with pytest.raises(ParameterError, match=r"units.*1e-15.*mm, mg, ms"):
+        attach(spec, "pedot-micro", site="mount", prefix="a", units=UnitSystem(1.0, 1.0, 1.0))
+
+
+def test_host_gravity_in_other_units_is_refused():
+    with pytest.raises(ParameterError, match="gravity.*-0.00980665"):
+        attach(host('<site name="mount"/>', gravity="0 0 -9.81"), "pedot-micro", site="mount", prefix="a")
