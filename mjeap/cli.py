@@ -142,6 +142,7 @@ def cmd_rollout(args) -> int:
                 initial_curvature=args.initial_curvature, rrd=args.rrd, csv_path=args.csv,
                 progress=None if not args.quiet else False, engine=args.engine)
     summary = {"actuator": scene.actuator.id, "drive": r.meta["drive"], "engine": r.meta["engine"],
+               "engine_reason": r.meta.get("engine_reason", ""),
                "voltage": args.voltage,
                "duration_s": args.duration, "timestep_s": scene.timestep, "steps": r.meta["steps"],
                "wall_time_s": round(r.meta["wall_time_s"], 3),

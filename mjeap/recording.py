@@ -170,7 +170,9 @@ def write_system_recording(path, result, system) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     m, L = system.model, system.units.length
     names = [a.prefix.rstrip("/") for a in system.actuators]
-    groups = [rrb.TimeSeriesView(origin=f"/plots/{n}", name=f"{n}: tip curvature (1/m), voltage (V)") for n in names]
+    groups = [rrb.Vertical(rrb.TimeSeriesView(origin=f"/plots/{n}/tip_curvature", name=f"{n}: tip curvature (1/m)"),
+                           rrb.TimeSeriesView(origin=f"/plots/{n}/voltage", name=f"{n}: voltage (V)"), name=n)
+              for n in names]
     touched = [b for b in range(m.nbody) if len(result.time) and np.abs(result.contact_force[:, b]).max() > 0]
     if touched:
         groups.append(rrb.TimeSeriesView(origin="/plots/contact", name="contact force (N)"))
@@ -190,17 +192,18 @@ def write_system_recording(path, result, system) -> Path:
             beam_bodies.update({p.tip_load_id, p.clamp_id})
         idx = np.arange(0, n, max(1, n // MAX_FRAMES)) if n else np.zeros(0, int)
         tf = rr.TimeColumn("time", duration=t[idx]) if n else None
-        # rigid bodies other than the beams: their geoms, posed per frame
-        for b in range(1, m.nbody):
-            if b in beam_bodies or m.body_geomnum[b] == 0:
+        # rigid bodies other than the beams (the world's own geoms too): their geoms, posed
+        # per frame; each actuator's clamp drawn as its model has it
+        for b in range(0, m.nbody):
+            if (b in beam_bodies and not any(b == p.clamp_id for p in system.parts)) or m.body_geomnum[b] == 0:
                 continue
-            ent = f"world/bodies/{result.body_names[b]}"
+            ent = f"world/bodies/{result.body_names[b] if b else 'world'}"
             for g in range(m.body_geomadr[b], m.body_geomadr[b] + m.body_geomnum[b]):
                 rgba = (np.clip(m.geom_rgba[g], 0, 1) * 255).astype(np.uint8)
                 arch = _geom_archetype(rr, m, g, L, rgba)
                 if arch is not None:
                     rec.log(f"{ent}/geom{g - m.body_geomadr[b]}", arch, static=True)
-            if n:
+            if b and n:
                 q = result.body_quat[idx, b]
                 rec.send_columns(ent, indexes=[tf], columns=rr.Transform3D.columns(
                     translation=result.body_position[idx, b], quaternion=q[:, [1, 2, 3, 0]]))

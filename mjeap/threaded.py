@@ -25,6 +25,7 @@ import mujoco
 import numpy as np
 from mujoco import rollout as mj_rollout
 
+from .drives.base import Drive
 from .errors import DivergenceError
 
 STATE = mujoco.mjtState.mjSTATE_FULLPHYSICS
@@ -166,13 +167,18 @@ def run_native(scene, native, drives: Sequence, v_steps: Sequence[np.ndarray], i
     template = np.empty(mujoco.mj_stateSize(m, spec))
     for drv in drives:          # the drives' signals read the native model's state
         drv.part = part
+    # drives that compute their signals from the states at the end keep those rows
+    batch = [type(drv).native_signal_history is not Drive.native_signal_history for drv in drives]
+    rows = [np.empty((len(sample_steps), state0.shape[1])) if bt else None for bt in batch]
     for b in range(B):
         native.drive = drives[b]
         native.reset(initial_curvatures[b])
         mujoco.mj_getState(m, d, state0[b], STATE)
         mujoco.mj_getState(m, d, template, spec)
         drives[b].native_prepare(v_steps[b])
-        samples[b].take(0.0, v_steps[b][0], drives[b].native_signals(0, part, h))
+        if batch[b]:
+            rows[b][0] = state0[b]
+        samples[b].take(0.0, v_steps[b][0], {} if batch[b] else drives[b].native_signals(0, part, h))
 
     def controls(s0, c, out):
         out[:] = template
@@ -189,7 +195,9 @@ def run_native(scene, native, drives: Sequence, v_steps: Sequence[np.ndarray], i
     def take(b, k, state):
         mujoco.mj_setState(m, d, state, STATE)
         mujoco.mj_kinematics(m, d)
-        samples[b].take(k * dt, v_steps[b][k - 1], drives[b].native_signals(k, part, h))
+        if batch[b]:
+            rows[b][samples[b].n] = state
+        samples[b].take(k * dt, v_steps[b][k - 1], {} if batch[b] else drives[b].native_signals(k, part, h))
 
     try:
         final, bad = roll(m, state0, controls, len(template), spec, n, sample_steps, take, nthread)
@@ -197,6 +205,10 @@ def run_native(scene, native, drives: Sequence, v_steps: Sequence[np.ndarray], i
             raise_bad(scene, put, drives, v_steps, bad)
         put(final[-1])
     finally:
+        for b in range(B):
+            if batch[b]:
+                n_b = samples[b].n
+                samples[b].sig = drives[b].native_signal_history(sample_steps[:n_b], rows[b][:n_b], part, h)
         for drv in drives:
             drv.part = scene.part
     # the scene and the (last) drive as the loop leaves them: final state, last moments applied

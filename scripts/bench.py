@@ -267,10 +267,13 @@ def bench_elastica(T=0.05, elements=20, with_pyelastica=True):
            "elastica_tip_m": [float(ref[0]), float(ref[1])], "simulated_s": T,
            "mjeap": [err(_mjeap_cantilever(b, T, P, n)) for n in (20, 50)],
            "mjeap_with_drive_callback": [err(_mjeap_cantilever(b, T, P, 20, drive=d))
-                                         for d in ("blocking-force", "rc-relaxation")]}
+                                         for d in ("blocking-force", "rc-relaxation")],
+           "mjeap_with_native_drive": err(_mjeap_cantilever(b, T, P, 20, drive="rc-relaxation", engine="native"))}
     out["mjeap_with_drive_callback"][0]["drive"] = "blocking-force at 0 V (no moment): the callback's cost alone"
     out["mjeap_with_drive_callback"][1]["drive"] = ("rc-relaxation at 0 V: seed 000's drive; its back-relaxation "
                                                     "creeps the beam, so the tip is not the elastic one")
+    out["mjeap_with_native_drive"]["drive"] = ("rc-relaxation compiled into the model (mjeap.native, Maxwell arms), "
+                                               "on mujoco.rollout")
     if not with_pyelastica:
         return out
     try:
@@ -287,6 +290,8 @@ def bench_elastica(T=0.05, elements=20, with_pyelastica=True):
             pe["wall_s"] / out["mjeap_with_drive_callback"][1]["wall_s"],
         "pyelastica_shifted_over_mjeap_20_with_blocking_force_callback":
             pe["wall_s"] / out["mjeap_with_drive_callback"][0]["wall_s"],
+        "pyelastica_shifted_over_mjeap_20_with_native_rc_relaxation":
+            pe["wall_s"] / out["mjeap_with_native_drive"]["wall_s"],
         "note": "equal accuracy: both tip errors below 0.1 % (PyElastica needs the half-element clamp shift; "
                 "its stock clamp is off by several % at this resolution and would need many more elements)"}
     return out

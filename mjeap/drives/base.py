@@ -218,6 +218,13 @@ class Drive:
         self.seek(k)
         return self.signals()
 
+    def native_signal_history(self, ks: np.ndarray, states: np.ndarray, part, handles,
+                              prefix: str = "") -> Optional[Dict[str, np.ndarray]]:
+        """The signals after the steps ``ks`` of a native run, all at once, from the model's
+        full-physics states then (one row each); None where the drive reads them one
+        sample at a time (:meth:`native_signals`)."""
+        return None
+
     def native_leave(self, k: int, part, handles, prefix: str = "") -> None:
         """After a native run of ``k`` steps whose final state ``part`` holds: take over that
         state and apply the last step's moments to the drive's own part (the scene), as the

@@ -119,10 +119,14 @@ class RCRelaxationDrive(Drive):
         return native.NativeHandles(relaxation_joints=relax)
 
     def _relaxation_adr(self, part, handles, prefix):
+        """(qpos addresses of the relaxation dofs, act address of the drive) in part's model."""
         m = part.model
-        ids = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, prefix + j) for j in handles.relaxation_joints]
-        a = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, prefix + handles.actuator)
-        return m.jnt_qposadr[ids], m.actuator_actadr[a]
+        key = (id(m), prefix)
+        if getattr(self, "_adr_key", None) != key:
+            ids = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, prefix + j) for j in handles.relaxation_joints]
+            a = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, prefix + handles.actuator)
+            self._adr_key, self._adr = key, (m.jnt_qposadr[ids], int(m.actuator_actadr[a]))
+        return self._adr
 
     def native_reset(self, part, handles, prefix=""):
         """The Maxwell arms hold the present shape at rest: k_inf theta + k1 (theta - r) = g
@@ -152,6 +156,24 @@ class RCRelaxationDrive(Drive):
         k1 = part.hinge_stiffness() * (z - pm) / z
         np.multiply(k1, part.data.qpos[qadr], out=self._m_relax)
         return self.signals()
+
+    def native_signal_history(self, ks, states, part, handles, prefix=""):
+        """:meth:`native_signals` for many samples at once, from the full-physics states."""
+        m = part.model
+        qadr, aadr = self._relaxation_adr(part, handles, prefix)
+        S = mujoco.mjtState
+        q0 = mujoco.mj_stateSize(m, S.mjSTATE_TIME)
+        a0 = mujoco.mj_stateSize(m, S.mjSTATE_TIME | S.mjSTATE_QPOS | S.mjSTATE_QVEL)
+        vc = states[:, a0 + aadr]
+        z, pm, _ = self._internal_rates()
+        k1 = part.hinge_stiffness() * (z - pm) / z
+        ks = np.asarray(ks)
+        v = np.where(ks > 0, self._v_native[np.maximum(ks - 1, 0)], 0.0)
+        C = self.params["capacitance"]
+        return {"double_layer_voltage (V)": vc, "charge (C)": C * vc,
+                "current (A)": C * self.params["pole_electrical"] * (v - vc),
+                "drive_moment (N m)": self.gamma * vc,
+                "relaxation_moment_mean (N m)": states[:, q0 + qadr] @ k1 / len(k1)}
 
     def native_leave(self, k, part, handles, prefix=""):
         """The loop drive's state from the native one (v_c, r = k1 r_native / k), its
