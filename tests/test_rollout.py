@@ -129,19 +129,21 @@ def test_cli_rollout_writes_recording_and_csv(tmp_path, capsys):
     assert "safe range" in capsys.readouterr().err
 
 
-def test_tip_force_acts_as_a_dead_load_through_rollouts():
+@pytest.mark.parametrize("engine", ["loop", "native"])
+def test_tip_force_acts_as_a_dead_load_through_rollouts(engine):
     """A tip force set on the scene survives the rollout's reset and stays a dead load at
     the tip point (massless tip-load body): the settled tip under P L^2/EI = 1 with a drive
     at 0 V (no moment) matches the elastica within 0.5 % (20 hinges: -0.07 %), the same as
-    Scene.run. Before the load body, the rollout lost the load at reset."""
+    Scene.run, on the loop and on the native engine (the load as xfrc_applied controls).
+    Before the load body, the rollout lost the load at reset."""
     from mjeap import analytical as an
     s = Scene("ppy-trilayer", gravity=False, damping_ratio=0.7)
     L, EI = s.layout.length, float(s.actuator.flexural_rigidity_at(0.0)[0])
     P = EI / L**2
     s.set_tip_force(P)
-    r = rollout(s, "step:0V", 40 / s.choice.first_frequency)
+    r = rollout(s, "step:0V", 40 / s.choice.first_frequency, engine=engine)
     ref = an.elastica_tip_force(P, L, EI).tip
-    assert r.meta["engine"] == "loop"
+    assert r.meta["engine"] == engine
     assert r.tip_position[-1, 1] == pytest.approx(ref[1], rel=5e-3)
     assert r.tip_position[-1, 0] == pytest.approx(ref[0], abs=5e-3 * L)
 
