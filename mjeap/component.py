@@ -93,6 +93,8 @@ class ActuatorPart:
         self._tip_force_world = np.zeros(3)
         self._tip_moment = 0.0
         self._data = None
+        #: counts changes of the hinge parameters (models derived from this one follow it)
+        self.revision = 0
 
     # ------------------------------------------------------------------ data
     @property
@@ -227,6 +229,7 @@ class ActuatorPart:
             raise ParameterError("representation", self.representation,
                                  "'hinge' (per-joint stiffness and damping are a hinge-chain notion)")
         n = self.layout.segments
+        self.revision += 1
         if stiffness is not None:
             k = np.broadcast_to(np.asarray(stiffness, float), (n,))
             if not np.all(np.isfinite(k) & (k > 0)):

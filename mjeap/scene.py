@@ -326,9 +326,16 @@ class Scene:
 
     def native_model(self, drive):
         """This beam with ``drive`` (a :class:`mjeap.Drive` of this scene) compiled into the
-        model as MuJoCo elements (:mod:`mjeap.native`)."""
+        model as MuJoCo elements (:mod:`mjeap.native`); built once per drive, parameters
+        and hinge parameters (a compile and a stability check, ~10 ms), then reused."""
         from .native import NativeModel
-        return NativeModel(self, drive)
+        key = (drive.name, repr(sorted(drive.params.items())), self.part.revision)
+        cache = self.__dict__.setdefault("_native_models", {})
+        if key not in cache:
+            cache[key] = NativeModel(self, drive)
+        nat = cache[key]
+        nat.drive = drive
+        return nat
 
     # ------------------------------------------------------------------ output
     def to_xml(self) -> str:
