@@ -1,108 +1,228 @@
-"""Rerun recordings of rollouts (``.rrd``), written headless.
+"""Rerun recordings of rollouts (``.rrd``), written headless, laid out for review.
 
 Entity paths (SI: metres, seconds, volts):
 
 * ``/beam/centreline`` LineStrips3D: clamp, hinges and tip (clamp frame, gravity-aware
-  world frame of the scene), ``/beam/tip`` and ``/beam/payload`` Points3D,
-  ``/beam/clamp`` Boxes3D (static)
+  world frame of the scene), drawn with the displayed deformation scale (see below);
+  ``/beam/tip`` and ``/beam/payload`` Points3D, ``/beam/clamp`` Boxes3D and
+  ``/beam/scale_bar`` (static)
 * ``/plots/voltage`` applied voltage (V)
 * ``/plots/tip_curvature/simulated`` and ``/plots/tip_curvature/reference`` (1/m):
   the arc through clamp and tip, and the analytical prediction where the drive has one
-* ``/plots/tip_position/x``, ``/plots/tip_position/y`` (m), ``/plots/tip_angle`` (rad)
-* ``/plots/drive/<signal>`` every drive signal (charge, moment, current, ...)
+  (thicker, orange, under the simulation: agreement shows as a blue line on orange)
+* ``/plots/tip_position/x``, ``/plots/tip_position/y`` (m, each in its own view),
+  ``/plots/tip_angle`` (rad)
+* ``/plots/drive/<signal>`` every drive signal, one view per unit (charge, currents,
+  moments, ...)
 * ``/log`` TextLog: warnings and, for a failed run, the error; ``/meta`` the run's
-  parameters as text (static)
+  parameters with their sources (static, in the layout)
 
-Timeline ``time`` is simulated time. A default blueprint lays the 3D view beside the
-time series.
+Timeline ``time`` is simulated time; the viewer opens paused. Deformation scale: where the
+largest deflection is below 1 % of L (piezo bimorphs: +-36 um on 9.2 mm), the 3D view
+shows the deflection magnified (x 2, 5, 10, ...) and says so in its title, as finite-element
+post-processors do; the time series are always true values.
 """
 from __future__ import annotations
 
 import json
 import re
+from collections import OrderedDict
 from pathlib import Path
 
 import numpy as np
 
 MAX_FRAMES = 2000
+#: deflection / L below which the 3D view magnifies the deformation
+SMALL_DEFLECTION = 0.01
+#: the magnified largest deflection, as a fraction of L
+SHOWN_DEFLECTION = 0.2
+SIMULATED = [40, 110, 220]
+REFERENCE = [255, 150, 30]
 
 
 def _slug(name: str) -> str:
     return re.sub(r"[^a-z0-9_]+", "_", name.split(" (")[0].lower()).strip("_")
 
 
-def blueprint():
+def _unit(name: str) -> str:
+    m = re.search(r"\(([^)]*)\)\s*$", name)
+    return m.group(1) if m else "-"
+
+
+def deformation_scale(result, length: float) -> float:
+    """Displayed deformation scale of the 3D view: 1, or a 1-2-5 step that shows the largest
+    deflection at about SHOWN_DEFLECTION x L where it is below SMALL_DEFLECTION x L."""
+    if result.centreline is None or not len(result.time):
+        return 1.0
+    dev = np.abs(result.centreline[..., 1:]).max()
+    if not np.isfinite(dev) or dev <= 0 or dev >= SMALL_DEFLECTION * length:
+        return 1.0
+    want = SHOWN_DEFLECTION * length / dev
+    steps = np.array([1, 2, 5]) * 10.0 ** np.floor(np.log10(want))
+    return float(steps[steps <= want].max())
+
+
+def scale_bar_length(length: float) -> float:
+    """A 1-2-5 length (m) near a fifth of the beam, for the 3D view's scale bar."""
+    e = 10.0 ** np.floor(np.log10(0.2 * length))
+    return float(max(x for x in (e, 2 * e, 5 * e) if x <= 0.2 * length * 1.0001))
+
+
+def _drive_units(signals) -> "OrderedDict[str, list]":
+    groups: "OrderedDict[str, list]" = OrderedDict()
+    for k in signals:
+        groups.setdefault(_unit(k), []).append(k)
+    return groups
+
+
+def y_axis(*series):
+    """A fixed y range around the data (5 % margin), so a view is readable as it opens."""
     import rerun.blueprint as rrb
-    return rrb.Blueprint(
-        rrb.Horizontal(
-            rrb.Spatial3DView(origin="/beam", name="beam"),
-            rrb.Vertical(
-                rrb.TimeSeriesView(origin="/plots/tip_curvature", name="tip curvature (1/m)"),
-                rrb.TimeSeriesView(origin="/plots/voltage", name="voltage (V)"),
-                rrb.TimeSeriesView(origin="/plots/drive", name="drive"),
-                rrb.TimeSeriesView(origin="/plots/tip_position", name="tip position (m)"),
-            ),
-            column_shares=[2, 3],
-        ),
-        rrb.BlueprintPanel(state="collapsed"), rrb.SelectionPanel(state="collapsed"),
-    )
+    y = np.concatenate([np.asarray(v, dtype=float).ravel() for v in series if v is not None] or [np.zeros(1)])
+    y = y[np.isfinite(y)]
+    if not y.size:
+        return None
+    lo, hi = float(y.min()), float(y.max())
+    pad = 0.05 * (hi - lo) if hi > lo else max(abs(hi), 1e-300) * 0.05 or 1.0
+    return rrb.ScalarAxis(range=(lo - pad, hi + pad))
 
 
-def write_recording(path, result, scene, extra=None, views=()) -> Path:
+def _ts(origin: str, name: str, *series, contents=None):
+    import rerun.blueprint as rrb
+    kw = {} if contents is None else {"contents": contents}
+    return rrb.TimeSeriesView(origin=origin, name=name, axis_y=y_axis(*series), **kw)
+
+
+def camera(points: np.ndarray):
+    """A 3D eye looking at the points' box from a raised diagonal, 1.6 x its size away."""
+    import rerun.blueprint as rrb
+    p = np.asarray(points, dtype=float).reshape(-1, 3)
+    p = p[np.isfinite(p).all(axis=1)]
+    lo, hi = p.min(axis=0), p.max(axis=0)
+    c, size = 0.5 * (lo + hi), max(float(np.linalg.norm(hi - lo)), 1e-9)
+    d = np.array([0.55, -0.75, 0.6])
+    return rrb.archetypes.EyeControls3D(position=c + 1.6 * size * d / np.linalg.norm(d), look_target=c,
+                                        eye_up=[0.0, 0.0, 1.0])
+
+
+def blueprint(result=None, scale: float = 1.0, grid_spacing: float = 1e-3, extra_views=(), eye=None):
+    """The layout: the 3D beam (with a grid and the deformation scale in its title) over the
+    run's parameters, beside a grid of time series, one quantity (one unit) per view, each
+    with its y range fitted to the data."""
+    import rerun.blueprint as rrb
+    r = result
+    signals = {} if r is None else r.signals
+    drive_views = [_ts("/plots/drive", f"drive ({unit})", *[signals[k] for k in keys],
+                       contents=[f"/plots/drive/{_slug(k)}" for k in keys])
+                   for unit, keys in _drive_units(signals).items()]
+    title = "beam (m)" + ("" if scale == 1 else f", deformation shown x{scale:g}")
+    tip = (None, None) if r is None else (r.tip_position[:, 0], r.tip_position[:, 1])
+    # two rows of two, tall enough for labelled y ticks; the less central quantities as tabs
+    series = [_ts("/plots/tip_curvature", "tip curvature (1/m)", *(() if r is None else
+                                                                   (r.tip_curvature, r.reference_curvature))),
+              _ts("/plots/voltage", "voltage (V)", None if r is None else r.voltage),
+              _ts("/plots/tip_position/y", "tip deflection y (m)", tip[1]),
+              rrb.Tabs(*drive_views, _ts("/plots/tip_angle", "tip angle (rad)", None if r is None else r.tip_angle),
+                       _ts("/plots/tip_position/x", "tip axial x (m)", tip[0]), name="drive and tip")]
+    left = rrb.Vertical(rrb.Spatial3DView(origin="/beam", name=title, eye_controls=eye,
+                                          line_grid=rrb.archetypes.LineGrid3D(visible=True, spacing=grid_spacing)),
+                        rrb.TextDocumentView(origin="/meta", name="run parameters and sources"),
+                        row_shares=[3, 2])
+    right = rrb.Grid(*series, grid_columns=2)
+    root = rrb.Horizontal(left, right, column_shares=[2, 3])
+    if extra_views:
+        root = rrb.Vertical(root, rrb.Horizontal(*extra_views), row_shares=[3, 1])
+    return rrb.Blueprint(root, rrb.BlueprintPanel(state="collapsed"), rrb.SelectionPanel(state="collapsed"),
+                         rrb.TimePanel(state="collapsed", timeline="time", play_state="paused"))
+
+
+def _meta_markdown(meta: dict) -> str:
+    lines = ["| parameter | value |", "|---|---|"]
+    for k, v in meta.items():
+        if isinstance(v, dict):
+            continue
+        lines.append(f"| {k} | {v} |")
+    for k, v in meta.items():
+        if isinstance(v, dict):
+            lines += ["", f"**{k}**", "", "| name | value |", "|---|---|"]
+            lines += [f"| {kk} | {vv} |" for kk, vv in v.items()]
+    return "\n".join(lines)
+
+
+def write_recording(path, result, scene, extra=None, views=(), deformation: float = None) -> Path:
     """Write ``result`` of a rollout of ``scene`` to ``path`` (.rrd); the file is flushed
     and closed before returning, also for a failed (partial) run. ``extra(rec)`` may log
     more entities to the open ``rerun.RecordingStream``; ``views`` (rerun blueprint views)
-    are added to the default layout for them."""
+    are added to the default layout for them. ``deformation``: displayed deformation scale
+    of the 3D view (default: automatic, see the module)."""
     import rerun as rr
-    import rerun.blueprint as rrb
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    rec = rr.RecordingStream("mjeap", recording_id=f"{scene.actuator.id}-{result.meta.get('drive', '')}")
-    bp = blueprint()
-    if views:
-        bp = rrb.Blueprint(rrb.Vertical(bp.root_container, rrb.Horizontal(*views)),
-                           rrb.BlueprintPanel(state="collapsed"), rrb.SelectionPanel(state="collapsed"))
-    rec.save(str(path), default_blueprint=bp)
+    L = scene.layout.length
+    scale = deformation_scale(result, L) if deformation is None else float(deformation)
+    bar = scale_bar_length(L)
+    # an application per actuator and drive: Rerun keeps one blueprint per application, and
+    # the default layout here is fitted to this run's data
+    drive_name = str(result.meta.get("drive", "")).split(" (")[0]
+    rec = rr.RecordingStream(f"mjeap {scene.actuator.id} {drive_name}".strip(),
+                             recording_id=f"{scene.actuator.id}-{result.meta.get('drive', '')}")
+    shown = None
+    if len(result.time):
+        idx = np.arange(0, len(result.time), max(1, len(result.time) // MAX_FRAMES))
+        shown = result.centreline[idx].copy()
+        shown[..., 1:] *= scale                                      # magnified deflection
+        shown = shown @ scene.rotation.T                             # (f, N + 2, 3), world axes
+    eye = camera(np.vstack([shown.reshape(-1, 3), [[-0.1 * L, 0, 0]]]) if shown is not None else
+                 np.array([[0, 0, 0], scene.rotation @ [L, 0, 0]]))
+    rec.save(str(path), default_blueprint=blueprint(result, scale, bar, views, eye))
     try:
         t = result.time
         R = scene.rotation  # clamp frame -> world
-        rec.log("meta", rr.TextDocument(json.dumps(result.meta, indent=1, default=str), media_type="text/markdown"),
-                static=True)
-        L = scene.layout.length
+        rec.log("meta", rr.TextDocument(_meta_markdown({**result.meta, "deformation_shown": f"x{scale:g}"}),
+                                        media_type="text/markdown"), static=True)
         w = float(scene.actuator.width_at(0.0))
-        rec.log("beam/clamp", rr.Boxes3D(centers=[R @ [-0.04 * L, 0, 0]], half_sizes=[[0.04 * L, 0.02 * L, 0.6 * w]],
-                                         colors=[[90, 90, 90]]), static=True)
+        thick = scene.layout.thickness
+        rec.log("beam/clamp", rr.Boxes3D(centers=[R @ [-0.05 * L, 0, 0]],
+                                         half_sizes=[[0.05 * L, max(4 * thick, 0.02 * L), 0.55 * w]],
+                                         colors=[[90, 90, 90]], fill_mode="solid"), static=True)
+        # scale bar: along the beam axis, beside the clamp, labelled with its length
+        p0 = np.array([0.0, -0.15 * L, 0.0])
+        rec.log("beam/scale_bar", rr.LineStrips3D([[R @ p0, R @ (p0 + [bar, 0, 0])]], colors=[[230, 230, 230]],
+                                                  labels=[f"{bar * 1e3:g} mm"]), static=True)
         n = len(t)
         if n:
-            cols = [("plots/voltage", result.voltage, "voltage (V)"),
-                    ("plots/tip_curvature/simulated", result.tip_curvature, "simulated (mjeap)"),
-                    ("plots/tip_position/x", result.tip_position[:, 0], "tip x (m)"),
-                    ("plots/tip_position/y", result.tip_position[:, 1], "tip y (m)"),
-                    ("plots/tip_angle", result.tip_angle, "tip angle (rad)")]
+            cols = [("plots/voltage", result.voltage, "voltage (V)", SIMULATED, 1.5),
+                    ("plots/tip_curvature/simulated", result.tip_curvature, "simulated, mjeap (1/m)", SIMULATED, 1.5),
+                    ("plots/tip_position/x", result.tip_position[:, 0], "tip x, axial (m)", SIMULATED, 1.5),
+                    ("plots/tip_position/y", result.tip_position[:, 1], "tip y, deflection (m)", SIMULATED, 1.5),
+                    ("plots/tip_angle", result.tip_angle, "tip angle (rad)", SIMULATED, 1.5)]
             if result.reference_curvature is not None:
-                cols.append(("plots/tip_curvature/reference", result.reference_curvature,
-                             "reference (analytical)"))
-            for k, v in result.signals.items():
-                cols.append((f"plots/drive/{_slug(k)}", v, k))
-            for ent, y, label in cols:
-                rec.log(ent, rr.SeriesLines(names=label), static=True)
+                cols.insert(1, ("plots/tip_curvature/reference", result.reference_curvature,
+                                f"reference: {result.meta.get('reference', 'analytical model of the drive')} (1/m)",
+                                REFERENCE, 5.0))
+            palette = [[40, 110, 220], [220, 60, 60], [40, 160, 80], [150, 80, 200], [200, 140, 20], [20, 170, 170]]
+            for i, (k, v) in enumerate(result.signals.items()):
+                cols.append((f"plots/drive/{_slug(k)}", v, k, palette[i % len(palette)], 1.5))
+            for ent, y, label, color, width in cols:
+                rec.log(ent, rr.SeriesLines(names=label, colors=[color], widths=[width]), static=True)
                 rec.send_columns(ent, indexes=[rr.TimeColumn("time", duration=t)],
                                  columns=rr.Scalars.columns(scalars=np.asarray(y, dtype=float)))
             # 3D frames, decimated to at most MAX_FRAMES, sent as columns (one batch)
-            idx = np.arange(0, n, max(1, n // MAX_FRAMES))
             tf = rr.TimeColumn("time", duration=t[idx])
-            pts = result.centreline[idx] @ R.T                       # (f, N + 2, 3)
+            pts = shown
             rec.send_columns("beam/centreline", indexes=[tf],
                              columns=rr.LineStrips3D.columns(strips=list(pts)).partition([1] * len(idx)))
-            rec.log("beam/centreline", rr.LineStrips3D.from_fields(colors=[[50, 115, 205]]), static=True)
-            rec.send_columns("beam/tip", indexes=[tf],
-                             columns=rr.Points3D.columns(positions=pts[:, -1]))
-            rec.log("beam/tip", rr.Points3D.from_fields(radii=[0.01 * L], colors=[[255, 80, 30]]), static=True)
+            rec.log("beam/centreline", rr.LineStrips3D.from_fields(colors=[SIMULATED], radii=[max(thick, 0.004 * L)]),
+                    static=True)
+            rec.send_columns("beam/tip", indexes=[tf], columns=rr.Points3D.columns(positions=pts[:, -1]))
+            pay_r = scene.payload.sphere_radius if result.payload_position is not None else 0.0
+            rec.log("beam/tip", rr.Points3D.from_fields(radii=[max(0.015 * L, 1.1 * pay_r)], colors=[[255, 80, 30, 160]],
+                                                        labels=["tip"]), static=True)
             if result.payload_position is not None:
-                rec.send_columns("beam/payload", indexes=[tf],
-                                 columns=rr.Points3D.columns(positions=result.payload_position[idx] @ R.T))
-                rec.log("beam/payload", rr.Points3D.from_fields(radii=[scene.payload.sphere_radius],
-                                                                colors=[[190, 50, 50]]), static=True)
+                pp = result.payload_position[idx].copy()
+                pp[:, 1:] *= scale
+                rec.send_columns("beam/payload", indexes=[tf], columns=rr.Points3D.columns(positions=pp @ R.T))
+                rec.log("beam/payload", rr.Points3D.from_fields(radii=[pay_r], colors=[[190, 50, 50]]), static=True)
         for w in result.meta.get("warnings", []):
             if n:
                 rec.set_time("time", duration=float(t[-1]))

@@ -1,0 +1,106 @@
+#!/usr/bin/env python
+"""Render Rerun recordings (.rrd) to PNG, headless: what a reviewer sees when opening them.
+
+    python scripts/render_recording.py out/pedot-micro.rrd [more.rrd ...] [--out-dir out/png]
+        [--size 1600x900] [--time SECONDS] [--timeout 120]
+
+Set-up (optional, not needed by the tests): Rerun's native viewer draws through Vulkan; on a
+machine without a GPU install Mesa's software rasterizer, e.g. on Debian/Ubuntu
+``apt-get install mesa-vulkan-drivers``. The script starts ``rerun --headless`` on a free
+local port, opens each file through Rerun's viewer-control API
+(``rerun.experimental.ViewerClient``), waits until the viewer reports that nothing is
+loading any more and every recording has its timelines, moves the time cursor (``--time``,
+default: the start, where the layout opens), waits for a few painted frames and saves the
+screenshot. A PNG per recording, named after it.
+"""
+import argparse
+import socket
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+
+def _free_port() -> int:
+    with socket.socket() as s:
+        s.bind(("127.0.0.1", 0))
+        return s.getsockname()[1]
+
+
+def _loaded(state) -> bool:
+    return (not state.loading and bool(state.recordings)
+            and all(t.end is not None for r in state.recordings for t in r.timelines)
+            and any(r.timelines for r in state.recordings))
+
+
+def _start(size: str, timeout: float):
+    """A headless viewer on a free port, and a client connected to it."""
+    from rerun.experimental import ViewerClient
+    port = _free_port()
+    proc = subprocess.Popen(["rerun", "--headless", "--window-size", size, "--port", str(port),
+                             "--hide-welcome-screen"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    t0 = time.monotonic()
+    while True:
+        try:
+            viewer = ViewerClient.connect(f"rerun+http://127.0.0.1:{port}/proxy")
+            viewer.get_state()
+            return proc, viewer
+        except Exception:
+            if time.monotonic() - t0 > timeout or proc.poll() is not None:
+                proc.kill()
+                raise RuntimeError("the headless Rerun viewer did not start (is a Vulkan driver installed? "
+                                   "apt-get install mesa-vulkan-drivers)") from None
+            time.sleep(0.5)
+
+
+def render_one(path, png: Path, size: str = "1600x900", at_time: float = None, timeout: float = 120.0) -> Path:
+    """One recording in a fresh viewer (a viewer keeps the first blueprint it saw for an
+    application), screenshot once everything has loaded."""
+    path = Path(path).resolve()
+    proc, viewer = _start(size, timeout)
+    try:
+        viewer.open(str(path))
+        t1 = time.monotonic()
+        while not _loaded(viewer.get_state()):
+            if time.monotonic() - t1 > timeout:
+                raise TimeoutError(f"{path} still loading after {timeout:g} s")
+            time.sleep(0.25)
+        rec = viewer.get_state().recordings[-1]
+        tl = next((t for t in rec.timelines if t.name == "time"), None)
+        if tl is not None:
+            ns = tl.start if at_time is None else int(round(at_time * 1e9))
+            viewer.set_time("time", duration=ns * 1e-9, recording=rec.store_id)
+        time.sleep(1.0)                           # a few frames for the views to lay out their data
+        png.parent.mkdir(parents=True, exist_ok=True)
+        viewer.save_screenshot(str(Path(png).resolve()))
+        return png
+    finally:
+        proc.terminate()
+        try:
+            proc.wait(10)
+        except subprocess.TimeoutExpired:
+            proc.kill()
+
+
+def render(paths, out_dir: Path, size: str = "1600x900", at_time: float = None, timeout: float = 120.0):
+    out = []
+    for p in paths:
+        png = render_one(p, Path(out_dir) / (Path(p).stem + ".png"), size, at_time, timeout)
+        print(png)
+        out.append(png)
+    return out
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("recordings", nargs="+")
+    ap.add_argument("--out-dir", default="out/png")
+    ap.add_argument("--size", default="1600x900", help="window size in logical points, WIDTHxHEIGHT")
+    ap.add_argument("--time", type=float, default=None, help="time cursor in s (default: the start)")
+    ap.add_argument("--timeout", type=float, default=120.0, help="s to wait for the viewer and each file")
+    a = ap.parse_args(argv)
+    render(a.recordings, Path(a.out_dir), a.size, a.time, a.timeout)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
