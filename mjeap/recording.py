@@ -248,6 +248,27 @@ def read_recording(path) -> dict:
     return out
 
 
+def read_blueprint(path) -> list:
+    """The default layout's views of a recording: dicts with 'kind' (e.g. 'TimeSeries',
+    '3D', '2D', 'TextDocument'), 'name' and 'origin' (entity path)."""
+    from rerun.chunk import RrdReader
+    reader = RrdReader(str(path))
+    views = []
+    for entry in reader.blueprints():
+        for chunk in reader.store(store=entry).stream():
+            if not (chunk.entity_path.startswith("/view/") and chunk.entity_path.count("/") == 2):
+                continue
+            b = chunk.to_record_batch()
+            col = {n: b.column(b.schema.names.index(n)).to_pylist() for n in b.schema.names
+                   if n.startswith("ViewBlueprint:")}
+            for kind, name, origin in zip(col.get("ViewBlueprint:class_identifier", []),
+                                          col.get("ViewBlueprint:display_name", []),
+                                          col.get("ViewBlueprint:space_origin", [])):
+                first = (lambda v: v[0] if isinstance(v, list) and v else v)
+                views.append({"kind": first(kind), "name": first(name), "origin": first(origin)})
+    return views
+
+
 def _geom_archetype(rr, model, g: int, length: float, color):
     """A Rerun archetype drawing geom ``g`` in its body's frame (SI), or None."""
     T = mujoco_types()

@@ -67,19 +67,25 @@ def main(argv=None):
         lines.append("\n(figure skipped: pip install -e '.[report]' for matplotlib)")
     (out / "report.md").write_text("\n".join(lines) + "\n")
 
+    # the recording: the report beside the map as a figure (axes, units, legend); without
+    # matplotlib the report's tables alone
     import rerun as rr
-    rec = rr.RecordingStream("mjeap-stability-map")
-    rec.save(str(out / "stability_map.rrd"))
-    rec.log("map/returns", rr.Points2D(np.column_stack([m[ok], v[ok] * 100]), colors=[[40, 170, 60]], radii=2.0),
-            static=True)
-    rec.log("map/collapsed", rr.Points2D(np.column_stack([m[~ok], v[~ok] * 100]), colors=[[220, 50, 40]], radii=2.0),
-            static=True)
-    for k, b in bounds.items():
-        rec.log(f"map/theory/{k.split(',')[0].replace(' ', '_')}_{int(round(b))}mg",
-                rr.LineStrips2D([[[b, 0.0], [b, 160.0]]], labels=[k]), static=True)
-    if (out / "stability_map.png").exists():
-        rec.log("figure", rr.EncodedImage(path=out / "stability_map.png"), static=True)
-    rec.log("report", rr.TextDocument("\n".join(lines), media_type="text/markdown"), static=True)
+    import rerun.blueprint as rrb
+    figure = out / "stability_map.png"
+    views = [rrb.TextDocumentView(origin="/report", name="stability map: report")]
+    if figure.exists():
+        views.append(rrb.Spatial2DView(origin="/figure", name="payload mass (mg) x amplitude (V)"))
+    rec = rr.RecordingStream("mjeap stability map")
+    rec.save(str(out / "stability_map.rrd"),
+             default_blueprint=rrb.Blueprint(rrb.Horizontal(*views, column_shares=[2, 3][:len(views)]),
+                                             rrb.BlueprintPanel(state="collapsed"),
+                                             rrb.SelectionPanel(state="collapsed"), rrb.TimePanel(state="collapsed")))
+    if figure.exists():
+        rec.log("figure", rr.EncodedImage(path=figure), static=True)
+    table = ["", "| payload (mg) | amplitude (V) | returns |", "|---|---|---|"]
+    table += [f"| {mm:.1f} | {vv:.3g} | {'yes' if o else 'no'} |" for mm, vv, o in zip(m, v, ok)]
+    rec.log("report", rr.TextDocument("\n".join([x for x in lines if not x.startswith("![")] + table),
+                                      media_type="text/markdown"), static=True)
     rec.flush()
     rec.disconnect()
     print("\n".join(lines))

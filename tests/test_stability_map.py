@@ -50,6 +50,9 @@ def test_script_writes_report_image_and_recording(tmp_path):
     report = (out / "report.md").read_text()
     assert "![stability map](stability_map.png)" in report and "relaxed EI" in report
     assert (out / "stability_map.png").stat().st_size > 10_000
-    from mjeap.recording import read_recording
+    from mjeap.recording import read_blueprint, read_recording
     rec = read_recording(out / "stability_map.rrd")
-    assert "/map/returns" in rec and "/figure" in rec and "/report" in rec
+    assert "/figure" in rec and "/report" in rec
+    # laid out: the report beside the figure (axes and units), no bare 2D scatter
+    assert {(v["kind"], v["origin"]) for v in read_blueprint(out / "stability_map.rrd")} == \
+        {("TextDocument", "/report"), ("2D", "/figure")}

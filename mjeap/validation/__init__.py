@@ -57,7 +57,8 @@ def run_validation(names: Optional[Iterable[str]] = None, out: Optional[Path] = 
         if out is not None:
             if figures:
                 report.write_figure(ex, out / f"{ex.name}.png")
-            report.write_recording(ex, out / f"{ex.name}.rrd")
+            png = out / f"{ex.name}.png"
+            report.write_recording(ex, out / f"{ex.name}.rrd", figure=png if figures and png.is_file() else None)
             report.write_json(done, out / "validation.json")
             report.write_markdown(done, out / "report.md", figures)
     return done

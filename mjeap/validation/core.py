@@ -66,6 +66,14 @@ class Curve:
 
 
 @dataclass
+class BeamShape:
+    """A beam's centreline (m, clamp frame) at some times: what the recording draws of a run."""
+
+    time: np.ndarray          # (n,) s
+    centreline: np.ndarray    # (n, N + 2, 3) m
+
+
+@dataclass
 class Experiment:
     name: str                         # short id, e.g. 'dadras2021-payloads'
     title: str
@@ -80,6 +88,10 @@ class Experiment:
                   experiment=self.name, **kw)
         self.checks.append(c)
         return c
+
+    def beam(self, label: str, scene) -> None:
+        """Keep the scene's present beam shape (a settled state) for the recording's 3D view."""
+        self.rollouts.append((label, BeamShape(np.zeros(1), scene.centreline()[None]), scene.rotation))
 
     def curve(self, panel, source, x, y, xlabel, ylabel, style="-") -> None:
         self.curves.append(Curve(panel, source, np.asarray(x, float), np.asarray(y, float), xlabel, ylabel, style))

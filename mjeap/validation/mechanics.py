@@ -56,6 +56,8 @@ def elastica(quick: bool = False) -> Experiment:
             ref = an.elastica_tip_force(P, L, EI)
             ys.append(tip[1])
             refs.append(ref.tip[1])
+            if a == 3.0:
+                ex.beam(f"{rep}: settled under P L^2/EI = 3", sc)
             if a in (0.05, 1.0, 3.0):
                 ex.check(f"{rep}: tip deflection, P L^2/EI = {a:g}", "m", tip[1], ref.tip[1],
                          "elastica (scipy solve_bvp)", tolerance=0.01)
@@ -95,6 +97,8 @@ def vibration(quick: bool = False) -> Experiment:
             sc = Scene(ACT, representation=rep, payload=pay, damping_ratio=0.005)
             ref = an.natural_frequencies(L, EI, M_BEAM / L, tip_mass=m, tip_inertia=pay.inertia if pay else 0.0, n=1)[0]
             f = free_vibration_frequency(sc)
+            if m == masses[-1]:
+                ex.beam(f"{rep}: {m * 1e6:g} mg at the tip, end of the free vibration", sc)
             fs.append(f)
             refs.append(ref)
             ex.check(f"{rep}: f1 with {m * 1e6:g} mg at the tip", "Hz", f, ref,
@@ -124,6 +128,7 @@ def buckling(quick: bool = False) -> Experiment:
                      "stable column returns straight (tolerance: 1 % of the push)", tolerance=0.01 * y0,
                      error_kind="absolute")
         else:
+            ex.beam(f"{factor:g} P_cr: post-buckled after 3 s", sc)
             x_ref, d_ref, _ = an.postbuckled_column(factor, L)
             ex.check(f"{factor:g} P_cr: post-buckled tip deflection", "m", abs(tip[1]), d_ref,
                      "post-buckled elastica (elliptic integrals)", tolerance=0.03)
@@ -146,6 +151,7 @@ def section(quick: bool = False) -> Experiment:
     sc = Scene("pvdf-60", gravity=False)
     P = 1e-5
     tip = settled(sc, force=P)
+    ex.beam("60PVDF under a 10 uN tip force (deflection as computed)", sc)
     ex.check("simulated 52 mm beam: tip compliance", "m/N", tip[1] / P, sc.layout.length**3 / (3 * 2.703e-5),
              "L^3 / (3 EI) with the thesis EI", tolerance=0.01)
     return ex

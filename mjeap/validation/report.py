@@ -6,7 +6,7 @@ from __future__ import annotations
 import json
 import re
 from pathlib import Path
-from typing import List
+from typing import Optional, List
 
 import numpy as np
 
@@ -92,46 +92,64 @@ def write_figure(ex: Experiment, path: Path) -> None:
     plt.close(fig)
 
 
-def write_recording(ex: Experiment, path: Path) -> None:
-    """Curves against time as time series (timeline ``time``), other curves as 2D line strips
-    (x, y in the units of their labels); the checks as a Markdown table."""
+def write_recording(ex: Experiment, path: Path, figure: Optional[Path] = None) -> None:
+    """The experiment as a Rerun recording laid out for review: the checks (verdict first),
+    curves against time as time series with fitted y axes, the report's figure as an image
+    (``figure``: its PNG; curves against other quantities are best read there, with axes and
+    units), without matplotlib those curves as a table, and the simulated beams in 3D."""
     import rerun as rr
     import rerun.blueprint as rrb
+    from ..recording import camera, y_axis
     panels = list(dict.fromkeys(c.panel for c in ex.curves))
-    views = []
-    for p in panels:
-        origin = f"/{_slug(p)}"
-        timed = any(c.xlabel.startswith("time") for c in ex.curves if c.panel == p)
-        views.append(rrb.TimeSeriesView(origin=origin, name=p) if timed else rrb.Spatial2DView(origin=origin, name=p))
-    if ex.rollouts:
-        views.append(rrb.Spatial3DView(origin="/beams", name="simulated beams (m)"))
-    bp = rrb.Blueprint(rrb.Horizontal(rrb.TextDocumentView(origin="/checks", name="checks"),
-                                      rrb.Grid(*views) if views else rrb.Spatial2DView(origin="/"),
-                                      column_shares=[1, 2]), collapse_panels=True)
-    rec = rr.RecordingStream("mjeap-validate", recording_id=ex.name)
+    timed = [p for p in panels if any(c.xlabel.startswith("time") for c in ex.curves if c.panel == p)]
+    untimed = [p for p in panels if p not in timed]
+    views = [rrb.TimeSeriesView(origin=f"/{_slug(p)}", name=f"{p} ({_unit_of(ex, p)})",
+                                axis_y=y_axis(*[c.y for c in ex.curves if c.panel == p])) for p in timed]
+    have_figure = figure is not None and Path(figure).is_file()
+    if have_figure:
+        views.append(rrb.Spatial2DView(origin="/figure", name="report figure (axes, units, sources)"))
+    elif untimed:
+        views.append(rrb.TextDocumentView(origin="/curves", name="curves (x, y)"))
+    beams = [(label, r, rotation) for label, r, rotation in ex.rollouts]
+    if beams:
+        pts_all = np.vstack([r.centreline.reshape(-1, 3) @ (np.eye(3) if rot is None else np.asarray(rot)).T
+                             for _, r, rot in beams])
+        views.append(rrb.Spatial3DView(origin="/beams", name="simulated beams (m)", eye_controls=camera(pts_all),
+                                       line_grid=rrb.archetypes.LineGrid3D(visible=True)))
+    checks = rrb.TextDocumentView(origin="/checks", name="checks")
+    root = rrb.Horizontal(checks, rrb.Grid(*views), column_shares=[2, 3]) if views else checks
+    bp = rrb.Blueprint(root, rrb.BlueprintPanel(state="collapsed"), rrb.SelectionPanel(state="collapsed"),
+                       rrb.TimePanel(state="collapsed", timeline="time", play_state="paused"))
+    rec = rr.RecordingStream(f"mjeap validate {ex.name}", recording_id=ex.name)
     rec.save(str(path), default_blueprint=bp)
     try:
         rec.log("checks", rr.TextDocument(markdown_section(ex, figures=False), media_type="text/markdown"), static=True)
+        if have_figure:
+            rec.log("figure", rr.EncodedImage(path=figure), static=True)
         palette = [[31, 119, 180], [255, 127, 14], [44, 160, 44], [214, 39, 40], [148, 103, 189], [140, 86, 75]]
+        table = []
         for i, c in enumerate(ex.curves):
-            ent = f"{_slug(c.panel)}/{_slug(c.source)}"
             color = palette[i % len(palette)]
-            if c.xlabel.startswith("time"):
-                rec.log(ent, rr.SeriesLines(names=c.source, colors=[color]), static=True)
+            if c.panel in timed:
+                ent = f"{_slug(c.panel)}/{_slug(c.source)}"
+                rec.log(ent, rr.SeriesLines(names=f"{c.source} ({c.ylabel})", colors=[color],
+                                            widths=[3.0 if "mjeap" not in c.source else 1.5]), static=True)
                 rec.send_columns(ent, indexes=[rr.TimeColumn("time", duration=c.x)],
                                  columns=rr.Scalars.columns(scalars=c.y))
-            elif c.style.startswith("-") and len(c.x) > 1:
-                rec.log(ent, rr.LineStrips2D([np.column_stack([c.x, c.y])], labels=[c.source], colors=[color]),
-                        static=True)
-            else:
-                rec.log(ent, rr.Points2D(np.column_stack([c.x, c.y]), labels=[c.source], colors=[color],
-                                         radii=[-3.0]), static=True)
-        for i, (label, r, rotation) in enumerate(ex.rollouts):
+            elif not have_figure:
+                table += [f"**{c.panel}: {c.source}**", "", f"| {c.xlabel} | {c.ylabel} |", "|---|---|"]
+                table += [f"| {_fmt(x)} | {_fmt(y)} |" for x, y in zip(c.x, c.y)] + [""]
+        if table:
+            rec.log("curves", rr.TextDocument("\n".join(table), media_type="text/markdown"), static=True)
+        for i, (label, r, rotation) in enumerate(beams):
             R = np.eye(3) if rotation is None else np.asarray(rotation)
             idx = np.arange(0, len(r.time), max(1, len(r.time) // MAX_BEAM_FRAMES))
             pts = r.centreline[idx] @ R.T
             ent = f"beams/{_slug(label)}"
             rec.log(ent, rr.LineStrips3D.from_fields(colors=[palette[i % len(palette)]], labels=[label]), static=True)
+            if len(idx) == 1:                      # a settled shape: no timeline
+                rec.log(ent, rr.LineStrips3D(list(pts)), static=True)
+                continue
             rec.send_columns(ent, indexes=[rr.TimeColumn("time", duration=r.time[idx])],
                              columns=rr.LineStrips3D.columns(strips=list(pts)).partition([1] * len(idx)))
     finally:
@@ -139,11 +157,18 @@ def write_recording(ex: Experiment, path: Path) -> None:
         rec.disconnect()
 
 
+def _unit_of(ex: Experiment, panel: str) -> str:
+    labels = {c.ylabel for c in ex.curves if c.panel == panel}
+    return ", ".join(sorted(labels))
+
+
 def markdown_section(ex: Experiment, figures: bool = True) -> str:
     out = [f"## {ex.title}", "", f"`{ex.name}` ({ex.seconds:.1f} s)", ""]
-    out += ["| quantity | simulated | reference | source | error | tolerance | verdict |", "|---|---|---|---|---|---|---|"]
+    # the verdict first and the (long) source last: a narrow view shows what matters
+    out += ["| verdict | quantity | simulated | reference | error | tolerance | source |", "|---|---|---|---|---|---|---|"]
     for r in rows([ex]):
-        out.append("| " + " | ".join(x.replace("|", "/") for x in r[1:]) + " |")
+        quantity, sim, ref, src, err, tol, verdict = r[1:]
+        out.append("| " + " | ".join(x.replace("|", "/") for x in (verdict, quantity, sim, ref, err, tol, src)) + " |")
     if ex.notes:
         out += [""] + [f"- {n}" for n in ex.notes]
     if figures and ex.curves:
