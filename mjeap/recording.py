@@ -311,20 +311,24 @@ def write_system_recording(path, result, system) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     m, L = system.model, system.units.length
     names = [a.prefix.rstrip("/") for a in system.actuators]
-    groups = [rrb.Vertical(rrb.TimeSeriesView(origin=f"/plots/{n}/tip_curvature", name=f"{n}: tip curvature (1/m)"),
-                           rrb.TimeSeriesView(origin=f"/plots/{n}/voltage", name=f"{n}: voltage (V)"), name=n)
+    res = result.actuators
+    groups = [rrb.Vertical(_ts(f"/plots/{n}/tip_curvature", f"{n}: tip curvature (1/m)", res[n].tip_curvature),
+                           _ts(f"/plots/{n}/voltage", f"{n}: voltage (V)", res[n].voltage), name=n)
               for n in names]
     touched = [b for b in range(m.nbody) if len(result.time) and np.abs(result.contact_force[:, b]).max() > 0]
     if touched:
-        groups.append(rrb.TimeSeriesView(origin="/plots/contact", name="contact force (N)"))
-    bp = rrb.Blueprint(rrb.Horizontal(rrb.Spatial3DView(origin="/world", name="system (m)"), rrb.Vertical(*groups),
-                                      column_shares=[3, 2]),
-                       rrb.BlueprintPanel(state="collapsed"), rrb.SelectionPanel(state="collapsed"))
+        groups.append(_ts("/plots/contact", "contact force (N)",
+                          *[np.linalg.norm(result.contact_force[:, b], axis=1) for b in touched]))
+    left = rrb.Vertical(rrb.Spatial3DView(origin="/world", name="system (m)",
+                                          line_grid=rrb.archetypes.LineGrid3D(visible=True)),
+                        rrb.TextDocumentView(origin="/meta", name="run parameters"), row_shares=[3, 1])
+    bp = rrb.Blueprint(rrb.Horizontal(left, rrb.Vertical(*groups), column_shares=[3, 2]),
+                       rrb.BlueprintPanel(state="collapsed"), rrb.SelectionPanel(state="collapsed"),
+                       rrb.TimePanel(state="collapsed", timeline="time", play_state="paused"))
     rec = rr.RecordingStream("mjeap", recording_id=f"system-{'-'.join(names)}")
     rec.save(str(path), default_blueprint=bp)
     try:
-        rec.log("meta", rr.TextDocument(json.dumps(result.meta, indent=1, default=str), media_type="text/markdown"),
-                static=True)
+        rec.log("meta", rr.TextDocument(_meta_markdown(result.meta), media_type="text/markdown"), static=True)
         t = result.time
         n = len(t)
         beam_bodies = set()
@@ -364,7 +368,7 @@ def write_system_recording(path, result, system) -> Path:
             rec.send_columns(f"world/{name}/centreline", indexes=[tf],
                              columns=rr.LineStrips3D.columns(strips=list(world)).partition([1] * len(idx)))
             rec.log(f"world/{name}/centreline", rr.LineStrips3D.from_fields(
-                colors=[[50, 115, 205]], radii=[0.5 * p.layout.thickness]), static=True)
+                colors=[SIMULATED], radii=[max(0.5 * p.layout.thickness, 0.004 * p.layout.length)]), static=True)
             rec.send_columns(f"world/{name}/tip", indexes=[tf], columns=rr.Points3D.columns(positions=world[:, -1]))
             rec.log(f"world/{name}/tip", rr.Points3D.from_fields(radii=[0.01 * p.layout.length],
                                                                 colors=[[255, 80, 30]]), static=True)

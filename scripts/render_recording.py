@@ -14,9 +14,11 @@ default: the start, where the layout opens), waits for a few painted frames and 
 screenshot. A PNG per recording, named after it.
 """
 import argparse
+import os
 import socket
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -33,12 +35,15 @@ def _loaded(state) -> bool:
             and all(t.end is not None for r in state.recordings for t in r.timelines))
 
 
-def _start(size: str, timeout: float):
-    """A headless viewer on a free port, and a client connected to it."""
+def _start(size: str, timeout: float, state_dir: str):
+    """A headless viewer on a free port, and a client connected to it. The viewer keeps its
+    state (the last blueprint of each application) in ``state_dir``, a fresh folder: a
+    blueprint saved by an earlier session would replace the recording's own layout."""
     from rerun.experimental import ViewerClient
     port = _free_port()
+    env = {**os.environ, "XDG_DATA_HOME": state_dir, "XDG_CONFIG_HOME": state_dir}
     proc = subprocess.Popen(["rerun", "--headless", "--window-size", size, "--port", str(port),
-                             "--hide-welcome-screen"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                             "--hide-welcome-screen"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env)
     t0 = time.monotonic()
     while True:
         try:
@@ -57,7 +62,8 @@ def render_one(path, png: Path, size: str = "1600x900", at_time: float = None, t
     """One recording in a fresh viewer (a viewer keeps the first blueprint it saw for an
     application), screenshot once everything has loaded."""
     path = Path(path).resolve()
-    proc, viewer = _start(size, timeout)
+    state = tempfile.TemporaryDirectory()
+    proc, viewer = _start(size, timeout, state.name)
     try:
         viewer.open(str(path))
         t1 = time.monotonic()
@@ -80,6 +86,7 @@ def render_one(path, png: Path, size: str = "1600x900", at_time: float = None, t
             proc.wait(10)
         except subprocess.TimeoutExpired:
             proc.kill()
+        state.cleanup()
 
 
 def render(paths, out_dir: Path, size: str = "1600x900", at_time: float = None, timeout: float = 120.0):
