@@ -32,6 +32,7 @@ def resonance(quick: bool = False) -> Experiment:
         sc = Scene(act_id, damping_ratio=0.005)
         act = sc.actuator
         f_sim = free_vibration_frequency(sc)
+        ex.beam(f"{act_id}: end of the free vibration", sc)
         f_ref = an.first_frequency_variable(act.length, _profile(act, "flexural_rigidity_at"),
                                             _profile(act, "mass_per_length_at"), f_sim)
         ex.check(f"{act_id}: f1 (geometry only, no tip extension)", "Hz", f_sim, f_ref,
@@ -64,6 +65,7 @@ def frequency_response(quick: bool = False) -> Experiment:
     decay = 1.0 / (sc.choice.damping_ratio * 2 * np.pi * cal.first_frequency)   # s, first mode's envelope
     r = rollout(sc, f"step:{bias / 2 + dv}V", 25 * decay, sample_interval=sc.timestep,
                 drive_params={"bias": bias}, progress=False)
+    ex.rollouts.append((f"{dv:g} V step of V_eff", r, sc.rotation))
     x = r.tip_position[:, 1]
     t_mid = 0.5 * (r.time[1:] + r.time[:-1])
     f = np.unique(np.concatenate([np.geomspace(1, 2000, 60), np.linspace(1500, 2000, 41)]))
@@ -115,6 +117,7 @@ def frequency_response(quick: bool = False) -> Experiment:
         r = rollout(sc, f"sine:{amp}V@{f_drive}Hz,offset={bias / 2}V", periods / f_drive, drive_params={"bias": bias},
                     sample_interval=sc.timestep, progress=False)
         last = r.time >= (periods - 2) / f_drive
+        ex.rollouts.append((f"{amp:g} V sine at {f_drive:g} Hz", r, sc.rotation))
         i_cap = r.signals["current_capacitive (A)"][last]
         i_mot = r.signals["current_motional (A)"][last]
         i_res = r.signals["current_resistive (A)"][last]

@@ -103,6 +103,9 @@ def metello(quick: bool = False) -> Experiment:
             compliance = (settle_tip(scene, 1e-4) - y_free) / 1e-4
             Fb = -y_free / compliance
             y_check = settle_tip(scene, Fb)
+            if j == len(FIELDS) - 2:
+                settle_tip(scene, 0.0)
+                ex.beam(f"{act_id}, {E / 1e6:.2f} MV/m, free", scene)
             free.append(y_free)
             blocked.append(-Fb)
             tag = f"{E / 1e6:.2f} MV/m"

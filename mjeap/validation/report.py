@@ -99,7 +99,7 @@ def write_recording(ex: Experiment, path: Path, figure: Optional[Path] = None) -
     units), without matplotlib those curves as a table, and the simulated beams in 3D."""
     import rerun as rr
     import rerun.blueprint as rrb
-    from ..recording import camera, y_axis
+    from ..recording import camera, deformation_scale, y_axis
     panels = list(dict.fromkeys(c.panel for c in ex.curves))
     timed = [p for p in panels if any(c.xlabel.startswith("time") for c in ex.curves if c.panel == p)]
     untimed = [p for p in panels if p not in timed]
@@ -111,10 +111,15 @@ def write_recording(ex: Experiment, path: Path, figure: Optional[Path] = None) -
     elif untimed:
         views.append(rrb.TextDocumentView(origin="/curves", name="curves (x, y)"))
     beams = [(label, r, rotation) for label, r, rotation in ex.rollouts]
+    scale = 1.0
     if beams:
+        # tiny motions (the piezo bimorphs) magnified as in the rollout recordings, and said so
+        scale = min(deformation_scale(r, float(np.linalg.norm(r.centreline[0, -1]))) for _, r, _ in beams)
         pts_all = np.vstack([r.centreline.reshape(-1, 3) @ (np.eye(3) if rot is None else np.asarray(rot)).T
                              for _, r, rot in beams])
-        views.append(rrb.Spatial3DView(origin="/beams", name="simulated beams (m)", eye_controls=camera(pts_all),
+        views.append(rrb.Spatial3DView(origin="/beams", eye_controls=camera(pts_all),
+                                       name="simulated beams (m)" + ("" if scale == 1 else
+                                                                     f", deformation shown x{scale:g}"),
                                        line_grid=rrb.archetypes.LineGrid3D(visible=True)))
     checks = rrb.TextDocumentView(origin="/checks", name="checks")
     root = rrb.Horizontal(checks, rrb.Grid(*views), column_shares=[2, 3]) if views else checks
@@ -144,7 +149,9 @@ def write_recording(ex: Experiment, path: Path, figure: Optional[Path] = None) -
         for i, (label, r, rotation) in enumerate(beams):
             R = np.eye(3) if rotation is None else np.asarray(rotation)
             idx = np.arange(0, len(r.time), max(1, len(r.time) // MAX_BEAM_FRAMES))
-            pts = r.centreline[idx] @ R.T
+            shown = r.centreline[idx].copy()
+            shown[..., 1:] *= scale
+            pts = shown @ R.T
             ent = f"beams/{_slug(label)}"
             rec.log(ent, rr.LineStrips3D.from_fields(colors=[palette[i % len(palette)]], labels=[label]), static=True)
             if len(idx) == 1:                      # a settled shape: no timeline
