@@ -248,6 +248,15 @@ def cmd_sweep(args) -> int:
     print(json.dumps({"results": str(s.path), "points": len(points), "ran": s.done, "skipped (already in the file)":
                       s.skipped, "failed": s.failed, "wall_s": round(s.wall_s, 3),
                       "rollouts_per_s": round(s.throughput, 3) if s.done else None}, indent=2))
+    if s.done and s.failed == s.done:
+        errors = {}
+        for row in sweep.read_results(s.path):
+            if row.get("error"):
+                errors[row["error"].split(" | ")[0]] = errors.get(row["error"].split(" | ")[0], 0) + 1
+        print(f"mjeap sweep: every point that ran failed ({s.failed}):", file=sys.stderr)
+        for e, n in sorted(errors.items(), key=lambda x: -x[1])[:5]:
+            print(f"  {n} x {e}", file=sys.stderr)
+        return 1
     return 0
 
 

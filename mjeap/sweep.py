@@ -22,6 +22,7 @@ import json
 import os
 import time
 import traceback
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Dict, Iterable, List, Optional, Sequence
@@ -124,9 +125,43 @@ def random_design(n: int, seed: int = 0, **ranges) -> List[dict]:
     return [{k: cols[k][i] for k in ranges} for i in range(int(n))]
 
 
-def point_id(point: dict) -> str:
-    """Stable key of a point: hash of its parameters (JSON, sorted keys)."""
-    return hashlib.sha1(json.dumps(point, sort_keys=True, default=float).encode()).hexdigest()[:12]
+def settings(base: Optional[dict] = None, metrics: Sequence[str] = ()) -> dict:
+    """Everything besides a point's own parameters that changes its row: the fixed
+    parameters (``base`` over the defaults), the metrics and the package version."""
+    from . import __version__
+    return {"base": {**PARAMETERS, **(base or {})}, "metrics": sorted(metrics), "mjeap": __version__}
+
+
+def point_id(point: dict, base: Optional[dict] = None, metrics: Sequence[str] = ()) -> str:
+    """Stable key of a point: hash of its parameters and of the sweep's :func:`settings`
+    (JSON, sorted keys), so that a rerun with other fixed settings computes its points."""
+    key = {"point": point, "settings": settings(base, metrics)}
+    return hashlib.sha1(json.dumps(key, sort_keys=True, default=float).encode()).hexdigest()[:12]
+
+
+def check_settings(points: Sequence[dict], base: Optional[dict]) -> None:
+    """Every name in ``base`` is a sweep parameter, and every ``drive.NAME`` (in base or the
+    points) a parameter of the actuator's drive; else UnknownNameError with the closest."""
+    from .drives import default_drive_name, get_drive_class
+    base = base or {}
+    for n in base:
+        if n not in PARAMETERS and not n.startswith("drive."):
+            raise UnknownNameError("fixed sweep setting (--set / base)", n,
+                                   [*PARAMETERS, "drive.NAME"])
+    for p in points:
+        full = {**PARAMETERS, **base, **p}
+        names = [k[6:] for k in full if k.startswith("drive.")]
+        if not names:
+            continue
+        act = str(full["actuator"])
+        try:
+            cls = get_drive_class(default_drive_name(act))
+        except MjeapError:
+            continue              # a user actuator or an unknown one: the point reports it
+        known = list(cls.PARAMETERS.get(act, cls.GENERIC_PARAMETERS)) + list(cls.extra_parameters(None))
+        for n in names:
+            if n not in known:
+                raise UnknownNameError(f"{cls.name} drive parameter (drive.NAME)", n, known)
 
 
 # ---------------------------------------------------------------- one point
@@ -140,7 +175,8 @@ def evaluate(point: dict, metrics: Sequence[str] = ("peak_to_peak", "returns"), 
     from .scene import Scene
 
     p = {**PARAMETERS, **(base or {}), **point}
-    row = {"point_id": point_id(point), **point, "error": "", "wall_s": 0.0}
+    row = {"point_id": point_id(point, base, metrics), **point, "error": "", "wall_s": 0.0,
+           "settings": json.dumps(settings(base, metrics), sort_keys=True, default=float)}
     for m in metrics:
         row[m] = ""
     t0 = time.perf_counter()
@@ -190,6 +226,21 @@ class SweepSummary:
     def throughput(self) -> float:
         """Rollouts per second of wall time (points run in this call)."""
         return self.done / self.wall_s if self.wall_s > 0 else float("nan")
+
+
+def _drop_torn_row(path: Path) -> None:
+    """A file cut mid-line (a killed writer) loses its partial last row, which would
+    otherwise count as done and have the next row glued onto it; the point runs again."""
+    if not path.exists() or path.stat().st_size == 0:
+        return
+    with open(path, "rb+") as fh:
+        data = fh.read()
+        if data.endswith(b"\n"):
+            return
+        cut = data.rfind(b"\n") + 1
+        fh.truncate(cut)
+    warnings.warn(f"{path}: dropped a partial last row ({len(data) - cut} bytes, cut mid-line); its point runs again",
+                  stacklevel=3)
 
 
 def read_results(path) -> List[dict]:
@@ -266,15 +317,17 @@ def run_sweep(points: Sequence[dict], path, metrics: Sequence[str] = ("peak_to_p
     points = list(points)
     for p in points:
         _check_names(p)
+    check_settings(points, base)
+    _drop_torn_row(path)
     done_ids = set()
     if path.exists() and path.stat().st_size > 0:
         done_ids = {row["point_id"] for row in read_results(path)}
     rrd_dir = str(rrd_dir or path.parent / (path.stem + "-rrd"))
     record = set(int(i) for i in record)
     jobs = [(p, tuple(metrics), base, rrd_dir if i in record else None) for i, p in enumerate(points)
-            if point_id(p) not in done_ids]
+            if point_id(p, base, metrics) not in done_ids]
     skipped = len(points) - len(jobs)
-    columns = ["point_id", *sorted({k for p in points for k in p}), *metrics, "error", "wall_s"]
+    columns = ["point_id", *sorted({k for p in points for k in p}), *metrics, "error", "wall_s", "settings"]
     path.parent.mkdir(parents=True, exist_ok=True)
     new_file = not path.exists() or path.stat().st_size == 0
     if not new_file:

@@ -36,7 +36,7 @@ def test_failed_points_are_recorded_and_the_sweep_resumes(tmp_path):
     s1 = run_sweep(POINTS[:2] + [bad], path, base=BASE, executor="serial", progress=False)
     assert (s1.done, s1.skipped, s1.failed) == (3, 0, 1)
     rows = {r["point_id"]: r for r in read_results(path)}
-    assert "payload.position" in rows[point_id(bad)]["error"]
+    assert "payload.position" in rows[point_id(bad, BASE, ("peak_to_peak", "returns"))]["error"]
     # an interrupted sweep (two of four done) resumes without recomputing them
     s2 = run_sweep(POINTS + [bad], path, base=BASE, executor="serial", progress=False)
     assert (s2.done, s2.skipped) == (2, 3)
@@ -51,7 +51,7 @@ def test_processes_and_serial_agree(tmp_path):
     a = {r["point_id"]: float(r["peak_to_peak"]) for r in read_results(serial.path)}
     b = {r["point_id"]: float(r["peak_to_peak"]) for r in read_results(procs.path)}
     assert a == b
-    assert (tmp_path / "b-rrd" / f"point-{point_id(POINTS[0])}.rrd").exists()
+    assert (tmp_path / "b-rrd" / f"point-{point_id(POINTS[0], BASE, ('peak_to_peak', 'returns'))}.rrd").exists()
 
 
 def test_dask_local_cluster_agrees(tmp_path):
