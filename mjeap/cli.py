@@ -140,7 +140,7 @@ def cmd_rollout(args) -> int:
     params = _params(args.param)
     r = rollout(scene, args.voltage, args.duration, drive=args.drive, drive_params=params,
                 initial_curvature=args.initial_curvature, rrd=args.rrd, csv_path=args.csv,
-                progress=None if not args.quiet else False, engine=args.engine)
+                progress=None if not args.quiet else False, engine=args.engine, max_steps=args.max_steps)
     summary = {"actuator": scene.actuator.id, "drive": r.meta["drive"], "engine": r.meta["engine"],
                "engine_reason": r.meta.get("engine_reason", ""),
                "voltage": args.voltage,
@@ -283,6 +283,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--rrd", help="write a Rerun recording here")
     p.add_argument("--csv", help="write the time series here")
     from .rollout import ENGINES
+    p.add_argument("--max-steps", type=int, default=None,
+                   help="refuse runs of more steps than this (default 20,000,000: minutes of work)")
     p.add_argument("--engine", choices=ENGINES, default="auto",
                    help="'loop' (Python lockstep), 'threaded' (mujoco.rollout; open-loop drives only) or "
                         "'auto' (threaded where it applies; default)")

@@ -156,8 +156,46 @@ class _Samples:
                              {k: x[:n] for k, x in self.sig.items()}, ref, meta)
 
 
-def _voltage_steps(wave, duration: float, dt: float, drive) -> np.ndarray:
-    n_steps = max(1, int(round(duration / dt)))
+#: runs of more steps are refused unless ``max_steps`` is raised (the voltage history alone
+#: takes 8 bytes a step; at ~10-30 us a step this is minutes of work)
+MAX_STEPS = 20_000_000
+#: a waveform whose energy above the step's Nyquist frequency exceeds this fraction is refused
+ALIASED_ENERGY = 1e-3
+
+
+def check_work(duration: float, dt: float, max_steps: Optional[int] = None) -> int:
+    """The number of steps of a run, refused before any work where the duration is shorter
+    than one timestep or the steps exceed ``max_steps`` (default MAX_STEPS)."""
+    limit = MAX_STEPS if max_steps is None else int(max_steps)
+    if duration < dt:
+        raise ParameterError("duration", f"{duration:g} s", f"at least one timestep ({dt:.4g} s)")
+    n = int(round(duration / dt))
+    if n > limit:
+        raise ParameterError("duration", f"{duration:g} s", f"at most {limit:,} steps of {dt:.4g} s "
+                             f"({limit * dt:.4g} s); this run needs {n:,} steps and {8 * n / 2**20:.0f} MiB for its "
+                             "voltage history alone. Raise max_steps (--max-steps) to run it")
+    return n
+
+
+def check_sampling(wave, dt: float) -> None:
+    """Refuse a waveform whose content the step cannot represent: a frequency at or above
+    the Nyquist frequency 1/(2 dt) (a sine of 13 kHz at dt = 77 us runs as an aliased
+    38 Hz one), or csv samples with more than ALIASED_ENERGY of their energy above it."""
+    if not isinstance(wave, Waveform):
+        return
+    f_n = 0.5 / dt
+    above = wave.content_above(f_n)
+    if above > (ALIASED_ENERGY if wave.kind == "csv" else 0.0):
+        what = (f"{above:.1%} of the csv signal's energy lies above" if wave.kind == "csv"
+                else f"frequency {wave.max_frequency:g} Hz is at or above")
+        raise ParameterError("voltage", getattr(wave, "text", str(wave)),
+                             f"content below the Nyquist frequency {f_n:.4g} Hz of the timestep {dt:.4g} s "
+                             f"({what} it and would alias)", "pass a smaller timestep to the Scene")
+
+
+def _voltage_steps(wave, duration: float, dt: float, drive, max_steps: Optional[int] = None) -> np.ndarray:
+    n_steps = check_work(duration, dt, max_steps)
+    check_sampling(wave, dt)
     t_steps = np.arange(n_steps) * dt
     v = np.zeros(n_steps) if wave is None else np.asarray(wave(t_steps), dtype=float) * np.ones(n_steps)
     drive.check_voltage(v)
@@ -207,7 +245,7 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
             initial_curvature: float = 0.0, rrd: Union[str, Path, None] = None,
             csv_path: Union[str, Path, None] = None, sample_interval: Optional[float] = None,
             progress: Optional[bool] = None, check_every: int = 100, controller=None,
-            engine: str = "auto") -> RolloutResult:
+            engine: str = "auto", max_steps: Optional[int] = None) -> RolloutResult:
     """Run ``scene`` driven by ``drive`` (name, instance or None for the actuator's own)
     with ``voltage`` (waveform text, :class:`Waveform` or callable v(t)) for ``duration`` s.
 
@@ -216,7 +254,9 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     ``rrd`` a Rerun recording is written (also when the run fails: it then ends with the
     error), with ``csv_path`` the time series as CSV. A diverging run raises
     :class:`DivergenceError` naming the step, the drive and the timestep. ``engine``:
-    'loop', 'threaded' (open-loop drives only, see the module) or 'auto'.
+    'loop', 'threaded' (open-loop drives only, see the module) or 'auto'. Refused before
+    any work: a duration shorter than a step, more than ``max_steps`` steps (default
+    MAX_STEPS), a waveform above the step's Nyquist frequency.
     """
     from .drives import make_drive
     from . import recording, threaded
@@ -227,7 +267,7 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
         make_drive(drive, scene, **(drive_params or {}))
     engine, engine_reason = _choose_engine(engine, scene, drv, controller)
     dt = scene.timestep
-    v_steps = _voltage_steps(wave, duration, dt, drv)
+    v_steps = _voltage_steps(wave, duration, dt, drv, max_steps)
     n_steps = len(v_steps)
     sample_steps = _sample_steps(n_steps, dt, sample_interval)
     nat = scene.native_model(drv) if engine == "native" else None

@@ -27,6 +27,7 @@ Damping and timestep are derived from the compiled model, never tuned by hand:
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 from typing import Optional, Sequence, Union
 
@@ -48,6 +49,8 @@ SETTLING_DAMPING_RATIO = 0.3
 INTEGRATORS = {"implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
                "discrete": mujoco.mjtIntegrator.mjINT_DISCRETE}
 DEFAULT_SEGMENTS = 20
+#: a payload heavier than this many beams is probably a unit slip (kg for mg): warned
+HEAVY_PAYLOAD = 1000.0
 #: tip angle (rad) of the uniform arc at which the cable's stability limit is checked
 #: besides the straight beam; seed 000's actuator bends to about 1.8 rad
 DEFAULT_MAX_BEND = 2.0
@@ -126,6 +129,10 @@ class Scene:
         self.max_bend = check_range("max_bend", max_bend, 0.0, 2 * np.pi, "rad")
         self.layout: BeamLayout = discretize(self.actuator, segments)
         check_payload(payload, self.layout)
+        beam_mass = float(self.layout.link_mass.sum())
+        if payload is not None and payload.mass > HEAVY_PAYLOAD * beam_mass:
+            warnings.warn(f"payload {payload.mass:.4g} kg is {payload.mass / beam_mass:.3g} x the beam's mass "
+                          f"({beam_mass:.3g} kg): check its unit (SI is kg; '12.6mg' for milligrams)", stacklevel=2)
         zeta = self.actuator.damping_ratio.value if damping_ratio is None else \
             check_range("damping_ratio", damping_ratio, 0.0, 10.0)
         self.rotation = clamp_rotation(orientation)

@@ -72,6 +72,21 @@ class Waveform:
     def max_frequency(self) -> float:
         return max(self.frequency, self.frequency_end)
 
+    def content_above(self, f_cut: float) -> float:
+        """Fraction of the signal's (non-constant) energy above ``f_cut`` (Hz) for ``csv``
+        samples (linear interpolation on their finest spacing, scipy-free rfft); for the
+        analytic kinds 1 where the fundamental (a chirp's end) reaches ``f_cut``, else 0."""
+        if self.kind != "csv":
+            return 1.0 if self.max_frequency >= f_cut else 0.0
+        ts, vs = self.samples
+        dt = float(np.min(np.diff(ts)))
+        n = int(min((ts[-1] - ts[0]) / dt + 1, 2**22))
+        grid = np.linspace(ts[0], ts[-1], n)
+        spec = np.abs(np.fft.rfft(np.interp(grid, ts, vs) - np.mean(vs))) ** 2
+        f = np.fft.rfftfreq(n, (ts[-1] - ts[0]) / max(n - 1, 1))
+        total = spec.sum()
+        return float(spec[f >= f_cut].sum() / total) if total > 0 else 0.0
+
 
 def _csv_samples(path: str) -> tuple:
     p = Path(path)

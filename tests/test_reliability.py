@@ -4,6 +4,7 @@ Sweeps: a point's identity includes every setting that changes its row (class 1)
 settings and drive parameters are checked before the first point (class 2), a torn last
 row is dropped before appending (class 9), a sweep in which every point failed exits
 non-zero (class 10)."""
+import numpy as np
 import pytest
 
 from mjeap.cli import main
@@ -56,3 +57,43 @@ def test_a_sweep_where_every_point_failed_exits_nonzero(tmp_path, capsys):
                  "--out", str(out), "--executor", "serial", "--quiet"])
     assert code == 1
     assert "every point that ran failed (2)" in capsys.readouterr().err
+
+
+# ---------------------------------------------------------------- rollouts (classes 3, 5)
+from mjeap import Scene, rollout                                     # noqa: E402
+from mjeap.errors import ParameterError                              # noqa: E402
+
+
+def test_a_waveform_above_the_nyquist_frequency_is_refused(tmp_path):
+    s = Scene("pedot-micro")                                       # dt 76.7 us: Nyquist 6.52 kHz
+    with pytest.raises(ParameterError, match=r"voltage.*Nyquist frequency 65\d\d Hz"):
+        rollout(s, "sine:1V@13000Hz", 0.01)
+    with pytest.raises(ParameterError, match="Nyquist"):
+        rollout(s, "chirp:1V@10Hz..9000Hz", 0.01)
+    rollout(s, "sine:1V@1000Hz", 0.002)                            # well below: runs
+    # csv samples: refused where their content lies above the limit, not for a fine time base
+    t = np.arange(0, 0.01, 1e-5)
+    for name, v in (("fast", np.sin(2 * np.pi * 13000 * t)), ("slow", np.sin(2 * np.pi * 100 * t))):
+        f = tmp_path / f"{name}.csv"
+        f.write_text("time,voltage\n" + "\n".join(f"{a:.8g},{b:.8g}" for a, b in zip(t, v)))
+        if name == "fast":
+            with pytest.raises(ParameterError, match="csv signal's energy"):
+                rollout(s, f"csv:{f}", 0.005)
+        else:
+            rollout(s, f"csv:{f}", 0.005)
+
+
+def test_work_is_bounded_before_it_starts():
+    s = Scene("pedot-micro")
+    with pytest.raises(ParameterError, match=r"duration.*at most 20,000,000 steps.*max_steps"):
+        rollout(s, "step:1V", 1e5)
+    with pytest.raises(ParameterError, match=r"duration.*at least one timestep"):
+        rollout(s, "step:1V", 1e-6)
+    with pytest.raises(ParameterError, match="at most 100 steps"):
+        rollout(s, "step:1V", 0.01, max_steps=100)
+    assert rollout(s, "step:1V", 0.01, max_steps=200).meta["steps"] == 130
+
+
+def test_a_payload_in_kilograms_where_milligrams_were_meant_is_warned():
+    with pytest.warns(UserWarning, match="check its unit"):
+        Scene("pedot-micro", payload="12.6kg@6.27mm")
