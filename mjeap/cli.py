@@ -340,6 +340,8 @@ def main(argv: Optional[List[str]] = None) -> int:
         return args.func(args)
     except MjeapError as e:
         print(f"mjeap: error: {e}", file=sys.stderr)
+        for note in getattr(e, "__notes__", ()):      # e.g. an output that could not be written too
+            print(f"mjeap: error: {note}", file=sys.stderr)
         return 2
 
 

@@ -9,6 +9,15 @@ class MjeapError(Exception):
     """Base class of mjeap's own errors."""
 
 
+class OutputError(MjeapError, OSError):
+    """An output (recording, CSV) could not be written: ``cannot write PATH: reason``. The
+    finished result rides along as ``result`` where there is one."""
+
+    def __init__(self, failures, result=None):
+        self.failures, self.result = list(failures), result
+        super().__init__("; ".join(f"cannot write {p}: {why}" for p, why in self.failures))
+
+
 class ParameterError(MjeapError, ValueError):
     """A parameter is outside its accepted range.
 

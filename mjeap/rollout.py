@@ -193,6 +193,55 @@ def check_sampling(wave, dt: float) -> None:
                              f"({what} it and would alias)", "pass a smaller timestep to the Scene")
 
 
+def check_outputs(**paths) -> Dict[str, Path]:
+    """The outputs a run will write (name -> path or None), checked before any work: distinct
+    files, not directories, in a folder that exists or can be made and is writable."""
+    import os
+    out, seen = {}, {}
+    for name, p in paths.items():
+        if p is None:
+            continue
+        p = Path(p)
+        key = p.resolve()
+        if key in seen:
+            raise ParameterError(name, str(p), f"a file other than the {seen[key]} output's")
+        seen[key] = name
+        if p.is_dir():
+            raise ParameterError(name, str(p), "a file path (it is a directory)")
+        parent = p.parent
+        try:
+            parent.mkdir(parents=True, exist_ok=True)
+        except OSError as e:
+            raise ParameterError(name, str(p), "a path in a folder that exists or can be made",
+                                 f"cannot write {p}: {e.strerror or e}") from None
+        if not os.access(parent, os.W_OK) or (p.exists() and not os.access(p, os.W_OK)):
+            raise ParameterError(name, str(p), "a writable path", f"cannot write {p}: permission denied")
+        out[name] = p
+    return out
+
+
+def write_outputs(writers, error: Optional[BaseException], result=None) -> None:
+    """Run each ``(path, write)`` on its own: one failing write does not stop the others.
+    The run's own error stays the error raised (the write failures are added to its notes);
+    without one, the failures raise :class:`OutputError` carrying the result."""
+    from .errors import OutputError
+    failures = []
+    for path, write in writers:
+        try:
+            write()
+        except Exception as e:                       # noqa: BLE001 - reported, never masks the run's error
+            failures.append((path, f"{type(e).__name__}: {e}"))
+    if not failures:
+        return
+    if error is not None:
+        notes = getattr(error, "__notes__", None)
+        if notes is None:
+            notes = error.__notes__ = []
+        notes.extend(f"cannot write {p}: {why}" for p, why in failures)
+        return
+    raise OutputError(failures, result)
+
+
 def _voltage_steps(wave, duration: float, dt: float, drive, max_steps: Optional[int] = None) -> np.ndarray:
     n_steps = check_work(duration, dt, max_steps)
     check_sampling(wave, dt)
@@ -262,6 +311,7 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     from . import recording, threaded
 
     duration = check_positive("duration", duration, "s")
+    check_outputs(rrd=rrd, csv_path=csv_path)
     wave = None if controller is not None else _waveform(voltage, duration)
     drv = drive if (drive is not None and not isinstance(drive, str)) else \
         make_drive(drive, scene, **(drive_params or {}))
@@ -294,10 +344,12 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
         result = samples.result(drv, initial_curvature, meta)
         if error is not None:
             meta["error"] = f"{type(error).__name__}: {error}"
+        writers = []
         if rrd is not None:
-            recording.write_recording(rrd, result, scene)
+            writers.append((rrd, lambda: recording.write_recording(rrd, result, scene)))
         if csv_path is not None and samples.n > 0:
-            result.to_csv(csv_path)
+            writers.append((csv_path, lambda: result.to_csv(csv_path)))
+        write_outputs(writers, error, result)
     return result
 
 

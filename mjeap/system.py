@@ -403,11 +403,13 @@ class System:
         by prefix). Returns a :class:`SystemResult`; with ``rrd`` a Rerun recording (written
         also when the run fails: it then ends with the error). ``on_sample(system)`` is
         called at every sample (e.g. to move a mocap body)."""
-        from .rollout import _Samples, _sample_steps, _voltage_steps, _waveform
+        from .rollout import _Samples, _sample_steps, _voltage_steps, _waveform, check_outputs, write_outputs
         duration = check_positive("duration", duration, "s")
+        check_outputs(rrd=rrd)
         waves = self._per_actuator("voltages", voltages)
         dt = self.timestep
-        n_steps = max(1, int(round(duration / dt)))
+        from .rollout import check_work
+        n_steps = check_work(duration, dt)
         v_steps = []
         for a, w in zip(self.actuators, waves):
             if a.drive is None:
@@ -486,5 +488,5 @@ class System:
                                fc[:n], meta)
             if rrd is not None:
                 from .recording import write_system_recording
-                write_system_recording(rrd, res, self)
+                write_outputs([(rrd, lambda: write_system_recording(rrd, res, self))], error, res)
         return res

@@ -97,3 +97,50 @@ def test_work_is_bounded_before_it_starts():
 def test_a_payload_in_kilograms_where_milligrams_were_meant_is_warned():
     with pytest.warns(UserWarning, match="check its unit"):
         Scene("pedot-micro", payload="12.6kg@6.27mm")
+
+
+# ---------------------------------------------------------------- outputs (class 4)
+def test_outputs_are_checked_before_stepping_and_written_independently(tmp_path, monkeypatch, capsys):
+    from mjeap import recording
+    from mjeap.errors import DivergenceError, OutputError
+    s = Scene("pedot-micro")
+    blocker = tmp_path / "a-file"
+    blocker.write_text("x")
+    steps = []
+    monkeypatch.setattr(s, "update_kinematics", lambda: steps.append(1), raising=False)
+    with pytest.raises(ParameterError, match="rrd.*cannot write"):
+        rollout(s, "step:1V", 0.01, rrd=blocker / "run.rrd", engine="loop")
+    with pytest.raises(ParameterError, match="csv_path.*other than the rrd"):
+        rollout(s, "step:1V", 0.01, rrd=tmp_path / "x.rrd", csv_path=tmp_path / "x.rrd")
+    assert not steps                                          # refused before any step
+    monkeypatch.undo()
+    # a recording that fails while being written: the CSV is still written and the run's
+    # result rides along with the error
+    def broken(*a, **k):
+        raise OSError("disk full")
+    monkeypatch.setattr(recording, "write_recording", broken)
+    with pytest.raises(OutputError, match="cannot write .*r.rrd: OSError: disk full") as e:
+        rollout(s, "step:1V", 0.01, rrd=tmp_path / "r.rrd", csv_path=tmp_path / "r.csv")
+    assert (tmp_path / "r.csv").stat().st_size > 0 and len(e.value.result.time) > 1
+    # ... and it never masks the run's own error
+    from mjeap.drives import DRIVES, Drive, register_drive
+
+    @register_drive
+    class Exploding(Drive):
+        name = "test-exploding-outputs"
+
+        def step(self, voltage, dt):
+            self.part.set_internal_moments(1e30)
+    try:
+        with pytest.raises(DivergenceError) as e:
+            rollout(s, "step:1V", 0.05, drive="test-exploding-outputs", rrd=tmp_path / "d.rrd",
+                    csv_path=tmp_path / "d.csv", engine="loop")
+        assert any("cannot write" in n for n in e.value.__notes__)
+        assert (tmp_path / "d.csv").stat().st_size > 0
+    finally:
+        DRIVES.pop("test-exploding-outputs")
+    monkeypatch.undo()
+    assert main(["rollout", "pedot-micro", "--voltage", "step:1V", "--duration", "0.01",
+                 "--rrd", str(blocker / "run.rrd")]) == 2
+    err = capsys.readouterr().err
+    assert "cannot write" in err and "Traceback" not in err
