@@ -18,6 +18,7 @@ evaluated for all steps up front (vectorised).
 from __future__ import annotations
 
 import csv
+import math
 import time as _time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -252,8 +253,31 @@ def _voltage_steps(wave, duration: float, dt: float, drive, max_steps: Optional[
 
 
 def _waveform(voltage, duration: float):
-    wave = parse_waveform(voltage) if isinstance(voltage, (str, Waveform)) else voltage
+    """A waveform from text, a :class:`Waveform`, a number (a constant voltage, V) or a
+    callable v(t); anything else is refused naming what is accepted."""
+    if isinstance(voltage, bool) or voltage is None:
+        raise ParameterError("voltage", voltage, "a waveform ('step:1V', 'sine:1V@2Hz', ...), a number of volts "
+                             "or a callable v(t); None only with a controller")
+    if isinstance(voltage, (int, float, np.number)):
+        v = float(voltage)
+        if not math.isfinite(v):
+            raise ParameterError("voltage", voltage, "a finite number of volts")
+        voltage = Waveform("step", amplitude=v, text=f"constant {v:g} V")
+    if not isinstance(voltage, (str, Waveform)) and not callable(voltage):
+        raise ParameterError("voltage", voltage, "a waveform text, a Waveform, a number of volts or a callable v(t)")
+    wave = parse_waveform(voltage) if isinstance(voltage, str) else voltage
     return wave.with_duration(duration) if isinstance(wave, Waveform) else wave
+
+
+#: the largest initial bend accepted: a uniform arc closing into a full circle
+MAX_INITIAL_BEND = 2 * np.pi
+
+
+def check_initial_curvature(kappa, length: float, name: str = "initial_curvature") -> float:
+    """A finite initial curvature (1/m) whose arc bends at most MAX_INITIAL_BEND over the
+    beam (|kappa| L <= 2 pi: a full circle; more wraps the beam around itself)."""
+    from .errors import check_range
+    return check_range(name, kappa, -MAX_INITIAL_BEND / length, MAX_INITIAL_BEND / length, "1/m")
 
 
 def _sample_steps(n_steps: int, dt: float, sample_interval: Optional[float]) -> np.ndarray:
@@ -312,6 +336,7 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
 
     duration = check_positive("duration", duration, "s")
     check_outputs(rrd=rrd, csv_path=csv_path)
+    initial_curvature = check_initial_curvature(initial_curvature, scene.layout.length)
     wave = None if controller is not None else _waveform(voltage, duration)
     drv = drive if (drive is not None and not isinstance(drive, str)) else \
         make_drive(drive, scene, **(drive_params or {}))
@@ -385,6 +410,9 @@ def _run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, pro
                 if k % ctrl_every == 0:
                     scene.update_kinematics()
                     u = float(controller(k * dt, scene))
+                    if not math.isfinite(u):     # not a clipping case: name who and when
+                        raise ParameterError("controller command", u, "a finite voltage",
+                                             f"{ctrl_name} at t = {k * dt:.6g} s")
                     v_hold = min(max(u, v_lo), v_hi)
                     saturated += v_hold != u
                 v_steps[k] = v_hold
@@ -395,6 +423,12 @@ def _run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, pro
                     scene._step_count = k + 1
                     scene.check_finite()
                 except DivergenceError as e:
+                    bad = d.qfrc_applied[~np.isfinite(d.qfrc_applied)]
+                    if bad.size:                 # the drive's own output, not the timestep
+                        raise DivergenceError(
+                            f"the drive {drv.describe()} applied a non-finite moment ({bad[0]}) by t = "
+                            f"{(k + 1) * dt:.6g} s (step {k + 1}), voltage {v_steps[k]:.4g} V; the beam was finite "
+                            "until then: check the drive, not the timestep") from None
                     who = f" Controller: {ctrl_name} (check its gains)." if controller is not None else ""
                     raise DivergenceError(f"{e} Drive: {drv.describe()}, voltage {v_steps[k]:.4g} V.{who}") from None
             if k + 1 == nxt:

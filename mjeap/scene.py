@@ -123,6 +123,12 @@ class Scene:
             raise ParameterError("integrator", integrator, f"one of {', '.join(INTEGRATORS)}")
         if isinstance(payload, str):
             payload = Payload.parse(payload)
+        if payload is not None and not isinstance(payload, Payload):
+            raise ParameterError("payload", payload, "a Payload(mass kg, position m) or text 'MASS@POSITION', "
+                                 "e.g. '12.6mg@6.27mm'")
+        if units is not None and not isinstance(units, UnitSystem):
+            raise ParameterError("units", units, "a UnitSystem (SI size of one internal length, mass and time "
+                                 "unit), e.g. UnitSystem(1e-3, 1e-6, 1e-3) for mm, mg, ms")
         self.units = units or DEFAULT_UNITS
         self.representation, self.orientation, self.payload = representation, orientation, payload
         self.integrator = integrator

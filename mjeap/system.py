@@ -322,8 +322,10 @@ class System:
         k0 = self._per_actuator("initial_curvatures", initial_curvatures)
         m, d = self.model, self.data
         mujoco.mj_resetData(m, d)
+        from .rollout import check_initial_curvature
         for p, k in zip(self.parts, k0):
             p.apply_loads()
+            k = check_initial_curvature(k, p.layout.length, "initial_curvatures")
             if k:
                 p.set_hinge_angles(np.full(p.layout.segments, float(k) * p.layout.ds), forward=False)
         mujoco.mj_forward(m, d)

@@ -144,3 +144,49 @@ def test_outputs_are_checked_before_stepping_and_written_independently(tmp_path,
                  "--rrd", str(blocker / "run.rrd")]) == 2
     err = capsys.readouterr().err
     assert "cannot write" in err and "Traceback" not in err
+
+
+# ---------------------------------------------------------------- classes 13, 14, 17
+def test_non_finite_drive_output_and_controller_command_are_named():
+    from mjeap.drives import DRIVES, Drive, register_drive
+    from mjeap.errors import DivergenceError
+
+    @register_drive
+    class NanDrive(Drive):
+        name = "test-nan-moment"
+
+        def step(self, voltage, dt):
+            self.part.set_internal_moments(float("nan"))
+    try:
+        with pytest.raises(DivergenceError, match="test-nan-moment applied a non-finite moment.*not the timestep"):
+            rollout(Scene("pedot-micro"), "step:1V", 0.05, drive="test-nan-moment", engine="loop")
+    finally:
+        DRIVES.pop("test-nan-moment")
+
+    class NanController:
+        name, interval = "nan-controller", 1e-3
+
+        def reset(self, scene, drive):
+            pass
+
+        def __call__(self, t, scene):
+            return float("nan") if t > 0.002 else 0.5
+    with pytest.raises(ParameterError, match=r"controller command.*nan-controller at t = 0\.00"):
+        rollout(Scene("pedot-micro"), None, 0.05, controller=NanController())
+
+
+@pytest.mark.parametrize("kappa", [float("nan"), float("inf"), 1e6, -1.1e3])
+def test_initial_curvature_beyond_a_full_circle_is_refused(kappa):
+    with pytest.raises(ParameterError, match=r"initial_curvature.*\[-1047\.2, 1047\.2\] 1/m"):
+        rollout(Scene("pedot-micro"), "step:1V", 0.01, initial_curvature=kappa)
+
+
+def test_python_api_refuses_what_is_ambiguous_and_accepts_a_number_as_volts():
+    with pytest.raises(ParameterError, match="payload.*MASS@POSITION"):
+        Scene("pedot-micro", payload=5)
+    with pytest.raises(ParameterError, match="units.*UnitSystem"):
+        Scene("pedot-micro", units="mm")
+    with pytest.raises(ParameterError, match="voltage.*None only with a controller"):
+        rollout(Scene("pedot-micro"), None, 0.01)
+    r = rollout(Scene("pedot-micro"), 1.5, 0.01)
+    assert np.all(r.voltage == 1.5) and r.meta["voltage"] == "constant 1.5 V"
