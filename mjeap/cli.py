@@ -126,7 +126,9 @@ def cmd_mjcf(args) -> int:
 def _params(pairs) -> dict:
     params = {}
     for kv in pairs or []:
-        k, _, v = kv.partition("=")
+        k, sep, v = kv.partition("=")
+        if not sep or not k.strip() or not v.strip():
+            raise ParameterError("--param", kv, "NAME=VALUE, e.g. --param gain=63")
         try:
             params[k] = json.loads(v)
         except json.JSONDecodeError:
@@ -223,14 +225,22 @@ def _sweep_values(spec: str, random: bool):
     if not sep or not rhs:
         raise ParameterError("--vary", spec, "NAME=a,b,c or NAME=lo:hi:n (grid) or NAME=lo..hi (with --random)")
     name = name.strip()
-    if ".." in rhs:
-        if not random:
-            raise ParameterError("--vary", spec, "a range lo..hi only with --random N")
-        lo, hi = (float(x) for x in rhs.split(".."))
-        return name, (lo, hi)
-    if rhs.count(":") == 2:
-        lo, hi, n = rhs.split(":")
-        return name, [float(x) for x in np.linspace(float(lo), float(hi), int(n))]
+    form = "NAME=a,b,c or NAME=lo:hi:n (grid) or NAME=lo..hi (with --random)"
+    try:
+        if ".." in rhs:
+            if not random:
+                raise ParameterError("--vary", spec, "a range lo..hi only with --random N")
+            lo, hi = (float(x) for x in rhs.split(".."))
+            return name, (lo, hi)
+        if ":" in rhs:
+            lo, hi, n = rhs.split(":")
+            if int(n) < 1:
+                raise ValueError("n < 1")
+            return name, [float(x) for x in np.linspace(float(lo), float(hi), int(n))]
+    except ValueError as e:
+        if isinstance(e, ParameterError):
+            raise
+        raise ParameterError("--vary", spec, form + " with numbers (n a positive integer)") from None
     return name, [_value(v) for v in rhs.split(",")]
 
 
@@ -242,7 +252,12 @@ def cmd_sweep(args) -> int:
     points = sweep.random_design(args.random, args.seed, **values) if args.random is not None else \
         sweep.grid(**values)
     base = {k: _value(v) for k, v in (kv.partition("=")[::2] for kv in (args.set or []))}
-    record = [int(i) for i in args.record.split(",")] if args.record else []
+    try:
+        record = [int(i) for i in args.record.split(",")] if args.record else []
+    except ValueError:
+        raise ParameterError("--record", args.record, "comma-separated point indices, e.g. --record 0,5") from None
+    if Path(args.out).is_dir():
+        raise ParameterError("--out", args.out, "a CSV file path (it is a directory)")
     s = sweep.run_sweep(points, args.out, metrics=args.metrics.split(","), base=base, executor=args.executor,
                         workers=args.workers, scheduler=args.scheduler, record=record, progress=not args.quiet)
     print(json.dumps({"results": str(s.path), "points": len(points), "ran": s.done, "skipped (already in the file)":

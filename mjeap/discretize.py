@@ -78,6 +78,8 @@ def parse_quantity(text: str, unit: str) -> float:
     if m is None:
         raise ParameterError("quantity", text, f"a number with an optional unit {unit!r}, e.g. '1.5{unit}'")
     value, suffix = float(m.group(1)), m.group(2)
+    if not np.isfinite(value):
+        raise ParameterError("quantity", text, f"a finite number (with unit {unit!r}); {m.group(1)} overflows")
     if suffix == "":
         return value
     base = {"kg": ("g", 1e-3)}.get(unit, (unit, 1.0))

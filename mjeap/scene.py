@@ -49,8 +49,9 @@ SETTLING_DAMPING_RATIO = 0.3
 INTEGRATORS = {"implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
                "discrete": mujoco.mjtIntegrator.mjINT_DISCRETE}
 DEFAULT_SEGMENTS = 20
-#: a payload heavier than this many beams is probably a unit slip (kg for mg): warned
-HEAVY_PAYLOAD = 1000.0
+#: a payload heavier than this many beams is probably a unit slip (kg for mg, a factor 1e6):
+#: warned. The HAMR leg's reflected leg mass is 4.7e4 beams (controllers/hamr_leg.py)
+HEAVY_PAYLOAD = 1e5
 #: tip angle (rad) of the uniform arc at which the cable's stability limit is checked
 #: besides the straight beam; seed 000's actuator bends to about 1.8 rad
 DEFAULT_MAX_BEND = 2.0

@@ -150,12 +150,18 @@ def parse_waveform(text: str) -> Waveform:
     for o in opts:
         key, _, val = o.partition("=")
         key = key.strip().lower()
+        if key in ("duty", "phase"):
+            try:
+                num = float(val)
+            except ValueError:
+                raise ParameterError(f"voltage option {key}", val, "a number, e.g. "
+                                     + ("duty=0.3" if key == "duty" else "phase=1.57 (rad)")) from None
         if key == "offset":
             kw["offset"] = parse_quantity(val, "V")
         elif key == "duty":
-            kw["duty"] = check_range("duty", float(val), 0.0, 1.0, lo_open=True, hi_open=True)
+            kw["duty"] = check_range("duty", num, 0.0, 1.0, lo_open=True, hi_open=True)
         elif key == "phase":
-            kw["phase"] = float(val)
+            kw["phase"] = num
         elif key == "delay":
             kw["delay"] = parse_quantity(val, "s")
         elif key == "duration":

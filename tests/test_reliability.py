@@ -190,3 +190,34 @@ def test_python_api_refuses_what_is_ambiguous_and_accepts_a_number_as_volts():
         rollout(Scene("pedot-micro"), None, 0.01)
     r = rollout(Scene("pedot-micro"), 1.5, 0.01)
     assert np.all(r.voltage == 1.5) and r.meta["voltage"] == "constant 1.5 V"
+
+
+# ---------------------------------------------------------------- classes 11, 12
+@pytest.mark.parametrize("params,words", [
+    ({"gain": float("nan")}, "gain=nan.*finite number"),
+    ({"pole_electrical": -5.0}, r"pole_electrical=-5.0.*\(0, inf\)"),
+    ({"zero": 0.2}, "zero=0.2.*above pole_mechanical"),
+    ({"gain": "abc"}, "gain='abc'.*finite number"),
+])
+def test_drive_parameters_are_checked_where_they_are_set(params, words):
+    with pytest.raises(ParameterError, match=words):
+        rollout(Scene("pedot-micro"), "step:1V", 0.01, drive_params=params)
+
+
+def test_malformed_options_get_a_clear_error(tmp_path, capsys):
+    s = Scene("pedot-micro")
+    with pytest.raises(ParameterError, match="voltage option duty.*'abc'.*a number"):
+        rollout(s, "square:1V@1Hz,duty=abc", 0.01)
+    with pytest.raises(ParameterError, match="1e400V.*finite number"):
+        rollout(s, "step:1e400V", 0.01)
+    cases = [
+        (["rollout", "pedot-micro", "--voltage", "step:1V", "--duration", "0.01", "--param", "gain"], "--param"),
+        (["rollout", "pedot-micro", "--voltage", "step:1V", "--duration", "0.01", "--param", "gain=abc"], "gain"),
+        (["sweep", "--vary", "amplitude=1:2:x", "--out", str(tmp_path / "s.csv")], "--vary"),
+        (["sweep", "--vary", "amplitude=1", "--record", "a", "--out", str(tmp_path / "s.csv")], "--record"),
+        (["sweep", "--vary", "amplitude=1", "--out", str(tmp_path)], "--out"),
+    ]
+    for argv, name in cases:
+        assert main(argv) == 2, argv
+        err = capsys.readouterr().err
+        assert name in err and "Traceback" not in err, (argv, err)

@@ -109,6 +109,8 @@ class Drive:
     PARAMETERS: ClassVar[Dict[str, Dict[str, Tuple[float, str, str]]]] = {}
     #: defaults for an actuator the source does not describe (a user's own), same layout
     GENERIC_PARAMETERS: ClassVar[Dict[str, Tuple[float, str, str]]] = {}
+    #: accepted (low, high) of numeric parameters, open bounds; every numeric one must be finite
+    RANGES: ClassVar[Dict[str, Tuple[float, float]]] = {}
     model_used: str = ""
 
     def __init__(self, scene, **params):
@@ -123,6 +125,19 @@ class Drive:
                 raise ParameterError(f"{self.name} parameter", k, f"one of {', '.join(sorted(defaults))}")
             self.params[k] = v
             self.sources[k] = "given by the user"
+        self._check_parameters()
+
+    def _check_parameters(self) -> None:
+        """Every parameter that defaults to a number must be a finite number, within RANGES."""
+        for k, v in self.params.items():
+            default = self.PARAMETERS.get(self.scene.actuator.id, self.GENERIC_PARAMETERS).get(k, (None,))[0]
+            if not isinstance(default, (int, float)) or isinstance(default, bool):
+                continue
+            if isinstance(v, bool) or not isinstance(v, (int, float, np.number)) or not np.isfinite(v):
+                raise ParameterError(f"{self.name} parameter {k}", v, "a finite number")
+            lo, hi = self.RANGES.get(k, (-np.inf, np.inf))
+            if not lo < v < hi:
+                raise ParameterError(f"{self.name} parameter {k}", v, f"a value in ({lo:g}, {hi:g})")
 
     def extra_parameters(self) -> Tuple[str, ...]:
         return ()

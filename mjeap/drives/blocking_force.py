@@ -46,6 +46,7 @@ class BlockingForceDrive(Drive):
         "time_constant": (2.0, "s", "estimate (PPy trilayers of this size settle in seconds; not extractable from seed 001)"),
     }}
     GENERIC_PARAMETERS = PARAMETERS["ppy-trilayer"]
+    RANGES = {"time_constant": (0.0, np.inf)}
 
     def extra_parameters(self):
         return ("stiffness_table",)
@@ -54,8 +55,6 @@ class BlockingForceDrive(Drive):
         super().__init__(scene, **params)
         self.stiffness = VoltageTable(self.params.get("stiffness_table", ()), "stiffness_table")
         tau = float(self.params["time_constant"])
-        if tau <= 0:
-            raise ParameterError("time_constant", tau, "a positive time in s")
         F1 = float(self.params["blocking_force_per_volt"])
         self.force = ExactLTI([[-1 / tau]], [F1 / tau], [[1.0]], [0.0], scene.timestep)
         self.L = scene.layout.length

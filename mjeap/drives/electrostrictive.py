@@ -71,6 +71,8 @@ class ElectrostrictiveDrive(Drive):
                           "model": ("maxwell", "-", f"{_T}, eqs. 3.7-3.11"),
                           "stiffening": (False, "-", "no measured slopes for this actuator")}
 
+    RANGES = {"relative_permittivity": (0.0, np.inf)}
+
     def __init__(self, scene, **params):
         super().__init__(scene, **params)
         if self.params["model"] not in ("maxwell", "eigenstrain"):

@@ -22,7 +22,6 @@ from typing import Dict
 import mujoco
 import numpy as np
 
-from ..errors import ParameterError
 from .base import Drive, register_drive
 
 _J = "Jafferis et al. 2015: f31 ~ 32 Pa m/V free (24 blocked)"
@@ -45,11 +44,11 @@ class PiezoBimorphDrive(Drive):
     model_used = "unipolar simultaneous drive, Wood/Jafferis effective stress"
     PARAMETERS = {"pzt-hamr-large": _params(45.5), "pzt-hamr-small": _params(32.2), "pzt-robobee": _params(10.1)}
     GENERIC_PARAMETERS = _params(32.2)
+    RANGES = {"bias": (0.0, 200.0 + 1e-9), "f31": (0.0, np.inf), "capacitance": (0.0, np.inf),
+              "resistance": (0.0, np.inf)}
 
     def __init__(self, scene, **params):
         super().__init__(scene, **params)
-        if not (0 < self.params["bias"] <= 200.0):
-            raise ParameterError("bias", self.params["bias"], "a value in (0, 200] V (seed 003)")
         act = scene.actuator
         names = [l.name for l in act.layers]
         self.t_p = act.layers[names.index("pzt-top")].thickness

@@ -24,6 +24,7 @@ import numpy as np
 from scipy import signal
 
 from ..analytical import DadrasModel
+from ..errors import ParameterError
 from .base import Drive, register_drive, zoh_first_order
 
 _SRC = "Dadras et al. 2021 (seed 000), eq. 8 (identified from a 3 V step)"
@@ -43,9 +44,16 @@ class RCRelaxationDrive(Drive):
         "capacitance": (1e-3, "F", "assumed (not in the source); only scales the reported charge and current"),
     }}
 
+    RANGES = {"zero": (0.0, np.inf), "pole_mechanical": (0.0, np.inf), "pole_electrical": (0.0, np.inf),
+              "capacitance": (0.0, np.inf)}
+
     def __init__(self, scene, **params):
         super().__init__(scene, **params)
         p = self.params
+        if not p["zero"] > p["pole_mechanical"]:
+            raise ParameterError(f"{self.name} parameter zero", p["zero"],
+                                 f"a value above pole_mechanical = {p['pole_mechanical']:g} 1/s (a back-relaxation "
+                                 "relaxes: relaxed stiffness EI p/z below the instantaneous EI)")
         self.EI = float(scene.actuator.flexural_rigidity_at(0.0)[0])
         self.gamma = p["gain"] * self.EI / p["pole_electrical"]   # N m per volt of v_c
         # state s = (r_1 .. r_N, v_c): the relaxation angle of every hinge and the
