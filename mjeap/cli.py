@@ -152,6 +152,10 @@ def cmd_rollout(args) -> int:
                "tip_curvature_peak_to_peak_per_m": r.peak_to_peak(),
                "tip_deflection_final_m": float(r.tip_position[-1, 1]),
                "rrd": args.rrd, "csv": args.csv}
+    if r.meta.get("warnings"):
+        summary["warnings"] = r.meta["warnings"]
+        for w in r.meta["warnings"]:
+            print(f"mjeap: warning: {w}", file=sys.stderr)
     print(json.dumps(summary, indent=2))
     return 0
 

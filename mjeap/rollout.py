@@ -349,6 +349,11 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     samples = _Samples(scene.part if nat is None else nat.part, len(sample_steps))
     meta = _meta(scene, drv, wave, duration, initial_curvature, n_steps, engine)
     meta["engine_reason"] = engine_reason
+    if scene.choice.buckled:
+        meta.setdefault("warnings", []).append(
+            f"{scene.actuator.id}: the straight beam is unstable under gravity (the payload is above the column "
+            "load): the run starts from that unstable equilibrium and only a disturbance (an initial curvature, a "
+            "voltage) makes it buckle; a result near zero here is not a stable beam")
     if controller is not None:
         meta["controller"] = getattr(controller, "name", type(controller).__name__)
     error = None

@@ -20,6 +20,8 @@ import hashlib
 import itertools
 import json
 import os
+import signal
+import threading
 import time
 import traceback
 import warnings
@@ -249,6 +251,22 @@ def read_results(path) -> List[dict]:
         return list(csv.DictReader(fh))
 
 
+def _die_with_parent() -> None:
+    """Linux: the kernel kills this worker when its parent dies (kill -9 of the sweep), so no
+    orphan keeps running with the CSV's points."""
+    try:
+        import ctypes
+        import signal
+        ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)   # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):   # pragma: no cover - not Linux
+        pass
+
+
+def _worker_init() -> None:
+    _die_with_parent()
+    _one_blas_thread()
+
+
 def _one_blas_thread() -> None:
     """Process-pool initializer: one BLAS thread per worker. A point's linear algebra is on
     matrices of a few dozen rows, where OpenBLAS's threads only cost; with one pool of them
@@ -268,14 +286,7 @@ def _submit_all(executor: str, workers: int, scheduler: Optional[str], jobs):
                 yield evaluate(*args)
         return
     if executor == "processes":
-        from concurrent.futures import ProcessPoolExecutor, as_completed
-        import multiprocessing as mp
-        # fork where there is one (fast start, works from any __main__), spawn elsewhere
-        ctx = mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn")
-        with ProcessPoolExecutor(max_workers=workers, mp_context=ctx, initializer=_one_blas_thread) as pool:
-            futures = [pool.submit(evaluate, *args) for args in jobs]
-            for fut in as_completed(futures):
-                yield fut.result()
+        yield from _run_processes(list(jobs), workers)
         return
     if executor == "dask":  # run_sweep has checked the name
         try:
@@ -299,6 +310,70 @@ def _submit_all(executor: str, workers: int, scheduler: Optional[str], jobs):
                 cluster.close()
 
 
+WORKER_DIED = ("worker process died while running this point (killed, e.g. by the out-of-memory killer, "
+               "or crashed); run alone after the pool broke, it died again")
+
+
+def _run_processes(jobs: list, workers: int):
+    """Local worker processes, at most ``workers`` points in flight. A worker that dies
+    breaks the pool: the points then in flight are run again one by one in a fresh
+    single-worker pool (the one that kills its worker again is recorded as failed), and the
+    sweep goes on in a fresh pool. Ctrl-C or SIGTERM cancels what has not started."""
+    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+    from concurrent.futures.process import BrokenProcessPool
+    import multiprocessing as mp
+    # fork where there is one (fast start, works from any __main__), spawn elsewhere
+    ctx = mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn")
+
+    def pool(n):
+        return ProcessPoolExecutor(max_workers=n, mp_context=ctx, initializer=_worker_init)
+
+    pending = list(jobs)
+    while pending:
+        suspects, ex = [], pool(workers)
+        inflight = {}
+        try:
+            while pending or inflight:
+                while pending and len(inflight) < workers:
+                    args = pending.pop(0)
+                    inflight[ex.submit(evaluate, *args)] = args
+                done, _ = wait(inflight, return_when=FIRST_COMPLETED)
+                for fut in done:
+                    args = inflight.pop(fut)
+                    try:
+                        yield fut.result()
+                    except BrokenProcessPool:
+                        suspects.append(args)
+                if suspects:
+                    suspects += list(inflight.values())
+                    break
+        except BaseException:               # Ctrl-C, SIGTERM, the caller closing: stop the workers now
+            for proc in list(getattr(ex, "_processes", {}).values()):
+                proc.terminate()
+            ex.shutdown(wait=False, cancel_futures=True)
+            raise
+        else:
+            ex.shutdown(wait=not suspects, cancel_futures=True)
+        for args in suspects:                      # one by one: find the point that kills
+            alone = pool(1)
+            try:
+                yield alone.submit(evaluate, *args).result()
+            except BrokenProcessPool:
+                point = args[0]
+                yield {"point_id": point_id(point, args[2], args[1]), **point, "error": f"WorkerDied: {WORKER_DIED}",
+                       "wall_s": 0.0, "settings": json.dumps(settings(args[2], args[1]), sort_keys=True, default=float)}
+            finally:
+                alone.shutdown(wait=False, cancel_futures=True)
+
+
+class _Terminated(KeyboardInterrupt):
+    """SIGTERM, turned into the same graceful stop as Ctrl-C."""
+
+
+def _sigterm(signum, frame):
+    raise _Terminated()
+
+
 def run_sweep(points: Sequence[dict], path, metrics: Sequence[str] = ("peak_to_peak", "returns"),
               base: Optional[dict] = None, executor: str = "processes", workers: int = 2,
               scheduler: Optional[str] = None, record: Sequence[int] = (), rrd_dir=None,
@@ -318,6 +393,32 @@ def run_sweep(points: Sequence[dict], path, metrics: Sequence[str] = ("peak_to_p
     for p in points:
         _check_names(p)
     check_settings(points, base)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    lock = _lock(path)
+    try:
+        return _run_locked(points, path, metrics, base, executor, workers, scheduler, record, rrd_dir, progress)
+    finally:
+        lock.close()
+
+
+def _lock(path: Path):
+    """An exclusive lock on ``path``.lock for the whole sweep: a second sweep on the same CSV
+    is refused (it would compute every point twice and duplicate rows)."""
+    fh = open(path.with_name(path.name + ".lock"), "a+")
+    try:
+        import fcntl
+        fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except ImportError:  # pragma: no cover - not POSIX
+        pass
+    except OSError:
+        fh.close()
+        raise ParameterError("path", str(path), "a CSV that no other sweep is writing",
+                             "another mjeap sweep holds its lock: refused, not waiting; let it finish or choose "
+                             "another --out") from None
+    return fh
+
+
+def _run_locked(points, path, metrics, base, executor, workers, scheduler, record, rrd_dir, progress):
     _drop_torn_row(path)
     done_ids = set()
     if path.exists() and path.stat().st_size > 0:
@@ -342,8 +443,17 @@ def run_sweep(points: Sequence[dict], path, metrics: Sequence[str] = ("peak_to_p
             bar = tqdm(total=len(jobs), unit="point", desc="sweep")
         except ImportError:  # pragma: no cover
             bar = None
-    failed, done = 0, 0
     t0 = time.perf_counter()
+    old = signal.signal(signal.SIGTERM, _sigterm) if threading.current_thread() is threading.main_thread() else None
+    try:
+        return _write_rows(path, columns, new_file, executor, workers, scheduler, jobs, bar, skipped, t0)
+    finally:
+        if old is not None:
+            signal.signal(signal.SIGTERM, old)
+
+
+def _write_rows(path, columns, new_file, executor, workers, scheduler, jobs, bar, skipped, t0):
+    failed, done = 0, 0
     with open(path, "a", newline="") as fh:
         w = csv.DictWriter(fh, fieldnames=columns)
         if new_file:

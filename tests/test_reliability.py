@@ -221,3 +221,72 @@ def test_malformed_options_get_a_clear_error(tmp_path, capsys):
         assert main(argv) == 2, argv
         err = capsys.readouterr().err
         assert name in err and "Traceback" not in err, (argv, err)
+
+
+def test_a_scene_past_the_buckling_load_says_so(tmp_path, capsys):
+    """150 mg standing up is above the instantaneous column load (132 mg): the run's
+    metadata, the CLI and the recording warn that it starts from an unstable equilibrium."""
+    from mjeap.recording import read_recording
+    s = Scene("pedot-micro", orientation="up", payload="150mg@6.27mm")
+    assert s.choice.buckled
+    r = rollout(s, "step:0V", 0.05, rrd=tmp_path / "b.rrd")
+    assert any("unstable" in w for w in r.meta["warnings"])
+    assert "/log" in read_recording(tmp_path / "b.rrd")
+    assert main(["rollout", "pedot-micro", "--orientation", "up", "--payload", "150mg@6.27mm", "--voltage", "step:0V",
+                 "--duration", "0.05", "--quiet"]) == 0
+    assert "unstable" in capsys.readouterr().err
+    ok = rollout(Scene("pedot-micro", orientation="up", payload="12.6mg@6.27mm"), "step:0V", 0.05)
+    assert not ok.meta.get("warnings")
+
+
+# ---------------------------------------------------------------- sweeps under faults (6, 7, 8)
+def _killer_metric(r, point, scene):
+    import os
+    import signal
+    if abs(point["amplitude"] - 0.7) < 1e-9:
+        os.kill(os.getpid(), signal.SIGKILL)            # as the OOM killer would
+    return 1.0
+
+
+def test_a_killed_worker_fails_its_point_and_the_sweep_goes_on(tmp_path):
+    from mjeap.sweep import METRICS, register_metric
+    register_metric("killer", _killer_metric)
+    try:
+        pts = grid(amplitude=[0.5, 0.7, 1.0, 1.2])
+        s = run_sweep(pts, tmp_path / "k.csv", metrics=("killer",), base={"duration": 0.05}, workers=2,
+                      progress=False)
+    finally:
+        METRICS.pop("killer")
+    rows = {float(r["amplitude"]): r for r in read_results(tmp_path / "k.csv")}
+    assert (s.done, s.failed) == (4, 1) and len(rows) == 4
+    assert "WorkerDied" in rows[0.7]["error"] and all(rows[a]["error"] == "" for a in (0.5, 1.0, 1.2))
+
+
+def test_a_second_sweep_on_the_same_file_is_refused(tmp_path):
+    import fcntl
+    out = tmp_path / "s.csv"
+    with open(tmp_path / "s.csv.lock", "a+") as held:
+        fcntl.flock(held, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        with pytest.raises(ParameterError, match="another mjeap sweep holds its lock"):
+            run_sweep(POINTS, out, base={"duration": 0.05}, executor="serial", progress=False)
+    assert run_sweep(POINTS, out, base={"duration": 0.05}, executor="serial", progress=False).done == 2
+
+
+def test_sigterm_stops_a_sweep_like_ctrl_c_and_keeps_its_rows(tmp_path):
+    import subprocess
+    import sys
+    import time
+    code = ("import sys, time\n"
+            "from mjeap.sweep import grid, run_sweep, register_metric\n"
+            "register_metric('slow', lambda r, p, s: time.sleep(0.3 if p['amplitude'] < 0.6 else 60) or 1.0)\n"
+            "run_sweep(grid(amplitude=[0.5, 0.55, 0.9, 1.0, 1.1]), sys.argv[1], metrics=('slow',),"
+            " base={'duration': 0.02}, workers=2, progress=False)\n")
+    out = tmp_path / "t.csv"
+    p = subprocess.Popen([sys.executable, "-c", code, str(out)])
+    t0 = time.time()
+    while time.time() - t0 < 30 and (not out.exists() or len(read_results(out)) < 2):
+        time.sleep(0.2)
+    p.terminate()                                        # SIGTERM
+    p.wait(timeout=20)                                   # does not wait for the 60 s points
+    assert time.time() - t0 < 60 and p.returncode != 0
+    assert len(read_results(out)) >= 2                   # finished rows kept
