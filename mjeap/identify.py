@@ -12,7 +12,6 @@
 """
 from __future__ import annotations
 
-import csv
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Dict, Optional, Sequence, Tuple, Union
@@ -24,6 +23,8 @@ from .errors import ParameterError
 
 #: fewest samples accepted by the fits
 MIN_SAMPLES = 20
+#: a step fit's transient must exceed its rms residual this many times
+SNR = 5.0
 
 
 # ---------------------------------------------------------------- data
@@ -58,13 +59,8 @@ def read_columns(path: Union[str, Path], columns: Sequence[str], min_samples: in
     """Read the named columns of a CSV with a header row. A header matches a requested name
     when it is equal or starts with it followed by ' (' (a unit), e.g. 'time (s)' for 'time'.
     The first column requested is the time base and is checked like :func:`check_series`."""
-    path = Path(path)
-    if not path.is_file():
-        raise ParameterError("data file", str(path), "an existing CSV file")
-    with open(path, newline="") as fh:
-        rows = list(csv.reader(fh))
-    if not rows:
-        raise ParameterError("data file", str(path), "a CSV with a header row and data")
+    from .csvio import number, read_rows
+    rows = read_rows(path, "data file")
     header = [h.strip() for h in rows[0]]
     idx = {}
     for c in columns:
@@ -75,10 +71,7 @@ def read_columns(path: Union[str, Path], columns: Sequence[str], min_samples: in
     data = {c: np.empty(len(rows) - 1) for c in columns}
     for r, row in enumerate(rows[1:], start=2):
         for c, i in idx.items():
-            try:
-                data[c][r - 2] = float(row[i]) if i < len(row) and row[i].strip() else np.nan
-            except ValueError:
-                raise ParameterError(f"column '{c}'", f"'{row[i]}' on line {r}", "numbers") from None
+            data[c][r - 2] = number(row[i], f"column '{c}'", r) if i < len(row) and row[i].strip() else np.nan
     t, *rest = check_series(data[columns[0]], *(data[c] for c in columns[1:]), names=columns[1:],
                             min_samples=min_samples)
     return {columns[0]: t, **dict(zip(columns[1:], rest))}
@@ -141,6 +134,12 @@ def fit_step_response(time, curvature, voltage: float, t_step: float = 0.0) -> S
         p = np.exp(lp)
         return A + B * np.exp(-p * tt) + C * np.exp(-(p + np.exp(ld)) * tt)
 
+    with np.errstate(over="ignore", invalid="ignore"):     # judged below: non-finite fits are refused
+        best = _best_fit(model, t, k, span)
+    return _step_fit(model, best, t, voltage)
+
+
+def _best_fit(model, t, k, span):
     best = None
     for p0 in (1.0 / span, 3.0 / span, 10.0 / span):
         for ratio in (3.0, 10.0, 30.0):
@@ -148,14 +147,27 @@ def fit_step_response(time, curvature, voltage: float, t_step: float = 0.0) -> S
             res = optimize.least_squares(lambda x: model(x, t) - k, x0, method="lm", max_nfev=4000)
             if best is None or res.cost < best.cost:
                 best = res
+    return best
+
+
+def _step_fit(model, best, t, voltage) -> "StepFit":
     A, B, C, lp, ld = best.x
     p = float(np.exp(lp))
     a = p + float(np.exp(ld))
     gV = A * p - C * (a - p)
     if gV == 0:
         raise ParameterError("curvature", "a response without a step", "a step response with a visible transient")
-    z = A * a * p / gV
-    rms = float(np.sqrt(np.mean(best.fun ** 2)))
+    with np.errstate(over="ignore", invalid="ignore"):
+        z = A * a * p / gV
+        rms = float(np.sqrt(np.mean(best.fun ** 2)))
+        swing = float(np.ptp(model(best.x, t)))
+    if not np.all(np.isfinite([A, B, C, p, a, gV, z, rms])):
+        raise ParameterError("curvature", "a fit with non-finite parameters", "data whose step response fits "
+                             "kappa = A + B exp(-p t) + C exp(-a t) with finite numbers (check the units and scale)")
+    if not swing > SNR * rms:
+        raise ParameterError("curvature", f"a transient of {swing:.3g} 1/m against a residual of {rms:.3g} 1/m",
+                             f"a step response whose transient is at least {SNR:g} x the fit's residual (flat data "
+                             "or noise has no transfer function to identify)")
     return StepFit(float(A), float(B), float(C), p, a, float(voltage), float(gV / voltage), float(z),
                    float(A + B + C), rms)
 

@@ -9,7 +9,7 @@ phase (rad), delay (s).
 """
 from __future__ import annotations
 
-import csv
+
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable, Dict, Optional
@@ -89,12 +89,9 @@ class Waveform:
 
 
 def _csv_samples(path: str) -> tuple:
-    p = Path(path)
-    if not p.exists():
-        raise ParameterError("csv", path, "an existing CSV file with columns time, voltage")
-    with p.open(newline="") as fh:
-        rows = list(csv.reader(fh))
-    if not rows:
+    from .csvio import read_rows
+    rows = read_rows(path, "csv")
+    if len(rows) < 3:
         raise ParameterError("csv", path, "a CSV file with a header and at least 2 rows")
     header = [h.strip().lower() for h in rows[0]]
     try:

@@ -290,3 +290,47 @@ def test_sigterm_stops_a_sweep_like_ctrl_c_and_keeps_its_rows(tmp_path):
     p.wait(timeout=20)                                   # does not wait for the 60 s points
     assert time.time() - t0 < 60 and p.returncode != 0
     assert len(read_results(out)) >= 2                   # finished rows kept
+
+
+# ---------------------------------------------------------------- identify (class 16)
+def _step_csv(path, kappa, header="time (s),tip_curvature (1/m)", delimiter=",", encoding="utf-8", bom=False):
+    t = np.linspace(0, 15, 300)
+    lines = [header.replace(",", delimiter)] + [f"{a:.6g}{delimiter}{b:.9g}" for a, b in zip(t, kappa(t))]
+    data = ("\ufeff" if bom else "") + "\n".join(lines) + "\n"
+    path.write_bytes(data.encode(encoding))
+    return path
+
+
+def test_identify_refuses_flat_noise_and_non_finite_fits(tmp_path, capsys):
+    rng = np.random.default_rng(0)
+    cases = {"flat": lambda t: np.full_like(t, 12.0), "noise": lambda t: rng.normal(0, 1, len(t)),
+             "huge": lambda t: 1e300 * (181 - 90 * np.exp(-1.8 * t) - 265 * np.exp(-0.3 * t))}
+    for name, k in cases.items():
+        f = _step_csv(tmp_path / f"{name}.csv", k)
+        assert main(["identify", "step", str(f), "--voltage", "3"]) == 2, name
+        err = capsys.readouterr().err
+        assert "mjeap: error: curvature" in err and "Infinity" not in err, (name, err)
+    good = _step_csv(tmp_path / "good.csv", lambda t: 181 - 90 * np.exp(-1.8 * t) - 265 * np.exp(-0.3 * t))
+    assert main(["identify", "step", str(good), "--voltage", "3"]) == 0
+
+
+def test_csvs_are_read_as_users_save_them(tmp_path, capsys):
+    k = lambda t: 181 - 90 * np.exp(-1.8 * t) - 265 * np.exp(-0.3 * t)      # noqa: E731
+    for kw in ({"bom": True}, {"delimiter": ";"}, {"encoding": "latin-1", "header": "time (s),courbure \u00b5 (1/m)"}):
+        f = _step_csv(tmp_path / "a.csv", k, **kw)
+        col = ["--curvature-column", "courbure \u00b5"] if "header" in kw else []
+        assert main(["identify", "step", str(f), "--voltage", "3", *col]) == 0, kw
+        capsys.readouterr()
+    binary = tmp_path / "b.csv"
+    binary.write_bytes(b"\x00\x01\x02" * 100)
+    assert main(["identify", "step", str(binary), "--voltage", "3"]) == 2
+    assert "binary" in capsys.readouterr().err
+    comma = tmp_path / "c.csv"
+    comma.write_text("time;tip_curvature\n" + "\n".join(f"{i};{i},5" for i in range(30)))
+    assert main(["identify", "step", str(comma), "--voltage", "3"]) == 2
+    assert "decimal comma" in capsys.readouterr().err
+    # the same reader serves csv: waveforms
+    w = tmp_path / "w.csv"
+    w.write_bytes(("\ufefftime;voltage\n" + "\n".join(f"{i * 1e-3};{0.5}" for i in range(20))).encode())
+    r = rollout(Scene("pedot-micro"), f"csv:{w}", 0.005)
+    assert np.allclose(r.voltage, 0.5)
