@@ -7,6 +7,17 @@ import os as _os
 # headless by default: mjeap never opens a window, and dm_control must not probe GLFW
 _os.environ.setdefault("MUJOCO_GL", "disable")
 
+def _mujoco_warning(message: str) -> None:
+    """MuJoCo's warnings as Python warnings (not stderr and a MUJOCO_LOG.TXT in the working
+    directory); its times are in the model's internal units (ms by default)."""
+    import warnings
+    warnings.warn(f"MuJoCo: {message.strip()} (times in the model's internal units; mjeap's default unit is "
+                  "1 ms)", RuntimeWarning, stacklevel=2)
+
+
+import mujoco as _mujoco  # noqa: E402
+_mujoco.set_mju_user_warning(_mujoco_warning)
+
 from .catalog import CATALOG, Actuator, Layer, Planform, get_actuator, actuator_ids  # noqa: E402
 from .discretize import BeamLayout, Payload, discretize, parse_quantity  # noqa: E402
 from .errors import DivergenceError, MjeapError, ParameterError, UnknownNameError  # noqa: E402

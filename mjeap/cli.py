@@ -263,7 +263,8 @@ def cmd_sweep(args) -> int:
     if Path(args.out).is_dir():
         raise ParameterError("--out", args.out, "a CSV file path (it is a directory)")
     s = sweep.run_sweep(points, args.out, metrics=args.metrics.split(","), base=base, executor=args.executor,
-                        workers=args.workers, scheduler=args.scheduler, record=record, progress=not args.quiet)
+                        workers=args.workers, scheduler=args.scheduler, record=record,
+                        progress=False if args.quiet else None)
     print(json.dumps({"results": str(s.path), "points": len(points), "ran": s.done, "skipped (already in the file)":
                       s.skipped, "failed": s.failed, "wall_s": round(s.wall_s, 3),
                       "rollouts_per_s": round(s.throughput, 3) if s.done else None}, indent=2))

@@ -74,3 +74,29 @@ def check_range(name: str, value: float, lo: float, hi: float, unit: str = "",
         interval = f"{'(' if lo_open else '['}{lo:.6g}, {hi:.6g}{')' if hi_open else ']'}"
         raise ParameterError(name, value, f"a value in {interval}{(' ' + unit) if unit else ''}")
     return v
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM, turned into the same clean stop as Ctrl-C (what was finished is written)."""
+
+
+class sigterm_as_interrupt:
+    """Context manager: within it (in the main thread) SIGTERM raises :class:`Terminated`,
+    a KeyboardInterrupt, so a run or a sweep ends as after Ctrl-C; the previous handler is
+    restored on exit. Elsewhere (another thread) it does nothing."""
+
+    def __enter__(self):
+        import signal
+        import threading
+        self._old = None
+        if threading.current_thread() is threading.main_thread():
+            def handler(signum, frame):
+                raise Terminated()
+            self._old = signal.signal(signal.SIGTERM, handler)
+        return self
+
+    def __exit__(self, *exc):
+        import signal
+        if self._old is not None:
+            signal.signal(signal.SIGTERM, self._old)
+        return False

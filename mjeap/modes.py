@@ -49,7 +49,7 @@ def linearize(model: mujoco.MjModel, eps: float = 1e-6, qpos=None) -> Linearizat
         return d.qfrc_passive.copy(), -d.qfrc_bias.copy()
 
     Ke, Kg = np.zeros((nv, nv)), np.zeros((nv, nv))
-    for i in range(nv):
+    for i in _progress(range(nv), nv, "linearising (finite differences)"):
         dq = np.zeros(nv)
         dq[i] = eps
         pp, gp = forces(dq)
@@ -64,6 +64,22 @@ def linearize(model: mujoco.MjModel, eps: float = 1e-6, qpos=None) -> Linearizat
             a = model.jnt_dofadr[j]
             Kj[a, a] = model.jnt_stiffness[j]
     return Linearization(M, Ke, Kg, Kj)
+
+
+#: scenes with this many dofs or more show progress while they are analysed (on a terminal):
+#: 1000 hinges take minutes (dense eigenvalues of the 2 nv step map in the bisection)
+PROGRESS_DOFS = 200
+
+
+def _progress(it, nv: int, what: str):
+    import sys
+    if nv < PROGRESS_DOFS or not sys.stderr.isatty():
+        return it
+    try:
+        from tqdm import tqdm
+    except ImportError:  # pragma: no cover
+        return it
+    return tqdm(it, desc=f"{what}, {nv} dofs", leave=False)
 
 
 def modal_frequencies(lin: Linearization, with_gravity: bool = True) -> np.ndarray:
@@ -132,7 +148,7 @@ def stability_limit(lin: Linearization, damping: np.ndarray, integrator: str, h_
     while not stable(lo):
         lo *= 0.5
     hi = h_max
-    for _ in range(60):
+    for _ in _progress(range(60), lin.M.shape[0], "stability limit (bisection)"):
         mid = np.sqrt(lo * hi)
         if stable(mid):
             lo = mid

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import csv
 import math
+import sys
 import time as _time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -28,7 +29,7 @@ import mujoco
 import numpy as np
 
 from .analytical import arc_curvature
-from .errors import DivergenceError, ParameterError, check_positive
+from .errors import DivergenceError, ParameterError, check_positive, sigterm_as_interrupt
 from .scene import Scene
 from .waveforms import Waveform, parse_waveform
 
@@ -281,7 +282,11 @@ def check_initial_curvature(kappa, length: float, name: str = "initial_curvature
 
 
 def _sample_steps(n_steps: int, dt: float, sample_interval: Optional[float]) -> np.ndarray:
-    every = max(1, int(round(sample_interval / dt))) if sample_interval else max(1, n_steps // DEFAULT_SAMPLES)
+    """The steps after which a sample is taken: every ``sample_interval`` (rounded to whole
+    steps) or, by default, every ceil(n / DEFAULT_SAMPLES) steps: at most DEFAULT_SAMPLES + 1
+    samples with the initial state, evenly spaced (the analytical references integrate on
+    them), the last within one interval of the end (the scene holds the final state)."""
+    every = max(1, int(round(sample_interval / dt))) if sample_interval else max(1, -(-n_steps // DEFAULT_SAMPLES))
     return np.arange(0, n_steps + 1, every)
 
 
@@ -323,7 +328,8 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     with ``voltage`` (waveform text, :class:`Waveform` or callable v(t)) for ``duration`` s.
 
     The beam starts at rest as a uniform arc of ``initial_curvature`` (1/m). Returns SI
-    arrays sampled every ``sample_interval`` s (default: at most 5000 samples). With
+    arrays sampled every ``sample_interval`` s (default: at most 5001 evenly spaced samples, the
+    initial state included; the scene is left in the final state). With
     ``rrd`` a Rerun recording is written (also when the run fails: it then ends with the
     error), with ``csv_path`` the time series as CSV. A diverging run raises
     :class:`DivergenceError` naming the step, the drive and the timestep. ``engine``:
@@ -358,6 +364,8 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
         meta["controller"] = getattr(controller, "name", type(controller).__name__)
     error = None
     wall0 = _time.perf_counter()
+    stop = sigterm_as_interrupt()
+    stop.__enter__()           # SIGTERM ends the run as Ctrl-C does: what was simulated is written
     try:
         if engine == "threaded":
             threaded.run(scene, [drv], [v_steps], [initial_curvature], sample_steps, [samples], nthread=0)
@@ -370,6 +378,7 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
         error = e
         raise
     finally:
+        stop.__exit__(None, None, None)
         meta["wall_time_s"] = _time.perf_counter() - wall0
         result = samples.result(drv, initial_curvature, meta)
         if error is not None:
@@ -394,7 +403,7 @@ def _run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, pro
         controller.reset(scene, drv)
         ctrl_every = max(1, int(round(getattr(controller, "interval", dt) / dt)))
         ctrl_name = meta["controller"]
-    show = (n_steps > PROGRESS_STEPS) if progress is None else progress
+    show = (n_steps > PROGRESS_STEPS and sys.stderr.isatty()) if progress is None else progress
     bar = tqdm(total=n_steps, unit="step", desc=f"{scene.actuator.id} {drv.name}", disable=not show,
                leave=False) if tqdm else None
     every = int(sample_steps[1] - sample_steps[0]) if ns > 1 else n_steps

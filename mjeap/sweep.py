@@ -20,8 +20,7 @@ import hashlib
 import itertools
 import json
 import os
-import signal
-import threading
+import sys
 import time
 import traceback
 import warnings
@@ -31,7 +30,7 @@ from typing import Callable, Dict, Iterable, List, Optional, Sequence
 
 import numpy as np
 
-from .errors import DivergenceError, MjeapError, ParameterError, UnknownNameError
+from .errors import DivergenceError, MjeapError, ParameterError, UnknownNameError, sigterm_as_interrupt
 
 EXECUTORS = ("processes", "serial", "dask")
 
@@ -366,18 +365,10 @@ def _run_processes(jobs: list, workers: int):
                 alone.shutdown(wait=False, cancel_futures=True)
 
 
-class _Terminated(KeyboardInterrupt):
-    """SIGTERM, turned into the same graceful stop as Ctrl-C."""
-
-
-def _sigterm(signum, frame):
-    raise _Terminated()
-
-
 def run_sweep(points: Sequence[dict], path, metrics: Sequence[str] = ("peak_to_peak", "returns"),
               base: Optional[dict] = None, executor: str = "processes", workers: int = 2,
               scheduler: Optional[str] = None, record: Sequence[int] = (), rrd_dir=None,
-              progress: bool = True) -> SweepSummary:
+              progress: Optional[bool] = None) -> SweepSummary:
     """Evaluate ``points`` and stream one CSV row per finished point to ``path``. Points
     already in the file (same ``point_id``) are skipped. ``record``: indices of points
     that also write a recording to ``rrd_dir`` (default: next to the CSV)."""
@@ -437,19 +428,15 @@ def _run_locked(points, path, metrics, base, executor, workers, scheduler, recor
         if header != columns:
             raise ParameterError("path", str(path), f"a CSV of this sweep (columns {columns}); it has {header}")
     bar = None
-    if progress:
+    if progress or (progress is None and sys.stderr.isatty()):      # no bar flooding a log file
         try:
             from tqdm import tqdm
             bar = tqdm(total=len(jobs), unit="point", desc="sweep")
         except ImportError:  # pragma: no cover
             bar = None
     t0 = time.perf_counter()
-    old = signal.signal(signal.SIGTERM, _sigterm) if threading.current_thread() is threading.main_thread() else None
-    try:
+    with sigterm_as_interrupt():
         return _write_rows(path, columns, new_file, executor, workers, scheduler, jobs, bar, skipped, t0)
-    finally:
-        if old is not None:
-            signal.signal(signal.SIGTERM, old)
 
 
 def _write_rows(path, columns, new_file, executor, workers, scheduler, jobs, bar, skipped, t0):

@@ -334,3 +334,35 @@ def test_csvs_are_read_as_users_save_them(tmp_path, capsys):
     w.write_bytes(("\ufefftime;voltage\n" + "\n".join(f"{i * 1e-3};{0.5}" for i in range(20))).encode())
     r = rollout(Scene("pedot-micro"), f"csv:{w}", 0.005)
     assert np.allclose(r.voltage, 0.5)
+
+
+# ---------------------------------------------------------------- smaller items
+def test_sigterm_ends_a_rollout_cleanly_with_its_outputs(tmp_path):
+    import subprocess
+    import sys
+    import time
+    rrd, csvp = tmp_path / "r.rrd", tmp_path / "r.csv"
+    p = subprocess.Popen([sys.executable, "-m", "mjeap.cli", "rollout", "pedot-micro", "--voltage", "step:1V",
+                          "--duration", "500", "--engine", "loop", "--rrd", str(rrd), "--csv", str(csvp), "--quiet"],
+                         stderr=subprocess.PIPE, text=True)
+    time.sleep(4)
+    p.terminate()
+    _, err = p.communicate(timeout=60)
+    assert p.returncode != 0
+    assert rrd.stat().st_size > 0 and len(csvp.read_text().splitlines()) > 2     # what was simulated is written
+    from mjeap.recording import read_recording
+    texts = [x for b in read_recording(rrd)["/log"] for x in b.column(b.schema.names.index("TextLog:text")).to_pylist()]
+    assert any("Terminated" in str(t) for t in texts)
+
+
+def test_mujoco_warnings_become_python_warnings_without_a_log_file(tmp_path, monkeypatch):
+    import mujoco
+    import mjeap  # noqa: F401  (installs the handler)
+    monkeypatch.chdir(tmp_path)
+    m = mujoco.MjModel.from_xml_string('<mujoco><worldbody><body><freejoint/><geom size="1"/></body></worldbody></mujoco>')
+    d = mujoco.MjData(m)
+    d.qacc_warmstart[:] = np.nan
+    d.qvel[0] = np.nan
+    with pytest.warns(RuntimeWarning, match="MuJoCo: .*internal units"):
+        mujoco.mj_step(m, d)
+    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()

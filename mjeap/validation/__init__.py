@@ -39,7 +39,8 @@ def run_validation(names: Optional[Iterable[str]] = None, out: Optional[Path] = 
     names = select(names)
     try:
         from tqdm import tqdm
-        bar = tqdm(names, desc="validate", unit="exp", disable=not progress)
+        import sys
+        bar = tqdm(names, desc="validate", unit="exp", disable=not (progress and sys.stderr.isatty()))
     except ImportError:  # pragma: no cover
         bar = names
     done: List[Experiment] = []
