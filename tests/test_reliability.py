@@ -272,24 +272,51 @@ def test_a_second_sweep_on_the_same_file_is_refused(tmp_path):
     assert run_sweep(POINTS, out, base={"duration": 0.05}, executor="serial", progress=False).done == 2
 
 
-def test_sigterm_stops_a_sweep_like_ctrl_c_and_keeps_its_rows(tmp_path):
+def _alive(pid: int) -> bool:
+    """Running (a zombie waiting to be reaped counts as gone)."""
+    try:
+        with open(f"/proc/{pid}/status") as fh:
+            return not any(line.startswith("State:") and "Z" in line.split()[1] for line in fh)
+    except FileNotFoundError:
+        return False
+
+
+@pytest.mark.parametrize("how", ["SIGTERM", "SIGKILL"])
+def test_stopping_a_sweep_stops_its_workers_and_keeps_its_rows(tmp_path, how):
+    """SIGTERM takes Ctrl-C's path (the workers are stopped, finished rows kept, no waiting
+    for the 60 s points in flight); kill -9 of the sweep leaves no orphaned worker (they die
+    with their parent)."""
+    import os
+    import signal
     import subprocess
     import sys
     import time
-    code = ("import sys, time\n"
+    pids = tmp_path / "pids"
+    pids.mkdir()
+    code = ("import os, sys, time\n"
             "from mjeap.sweep import grid, run_sweep, register_metric\n"
-            "register_metric('slow', lambda r, p, s: time.sleep(0.3 if p['amplitude'] < 0.6 else 60) or 1.0)\n"
+            "def slow(r, p, s):\n"
+            "    open(os.path.join(sys.argv[2], str(os.getpid())), 'w').close()\n"
+            "    time.sleep(0.3 if p['amplitude'] < 0.6 else 60)\n"
+            "    return 1.0\n"
+            "register_metric('slow', slow)\n"
             "run_sweep(grid(amplitude=[0.5, 0.55, 0.9, 1.0, 1.1]), sys.argv[1], metrics=('slow',),"
             " base={'duration': 0.02}, workers=2, progress=False)\n")
     out = tmp_path / "t.csv"
-    p = subprocess.Popen([sys.executable, "-c", code, str(out)])
+    p = subprocess.Popen([sys.executable, "-c", code, str(out), str(pids)])
     t0 = time.time()
     while time.time() - t0 < 30 and (not out.exists() or len(read_results(out)) < 2):
         time.sleep(0.2)
-    p.terminate()                                        # SIGTERM
-    p.wait(timeout=20)                                   # does not wait for the 60 s points
-    assert time.time() - t0 < 60 and p.returncode != 0
+    time.sleep(0.5)                                      # the 60 s points are in flight now
+    p.send_signal(signal.SIGTERM if how == "SIGTERM" else signal.SIGKILL)
+    p.wait(timeout=20)
+    assert time.time() - t0 < 40 and p.returncode != 0
     assert len(read_results(out)) >= 2                   # finished rows kept
+    workers = [int(x.name) for x in pids.iterdir()]
+    deadline = time.time() + 10
+    while time.time() < deadline and any(_alive(w) for w in workers):
+        time.sleep(0.2)
+    assert workers and not any(_alive(w) for w in workers), "orphaned sweep workers"
 
 
 # ---------------------------------------------------------------- identify (class 16)
