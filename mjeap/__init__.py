@@ -15,8 +15,14 @@ def _mujoco_warning(message: str) -> None:
                   "1 ms)", RuntimeWarning, stacklevel=2)
 
 
-import mujoco as _mujoco  # noqa: E402
-_mujoco.set_mju_user_warning(_mujoco_warning)
+def install_mujoco_warnings() -> None:
+    """Route MuJoCo's warnings through :func:`_mujoco_warning` (again after a library such
+    as dm_control installed its own handler)."""
+    import mujoco
+    mujoco.set_mju_user_warning(_mujoco_warning)
+
+
+install_mujoco_warnings()
 
 from .catalog import CATALOG, Actuator, Layer, Planform, get_actuator, actuator_ids  # noqa: E402
 from .discretize import BeamLayout, Payload, discretize, parse_quantity  # noqa: E402

@@ -26,10 +26,14 @@ from dm_control.suite import base
 from dm_control.utils import rewards
 from dm_env import specs
 
+from . import install_mujoco_warnings
+
 from .discretize import Payload
 from .drives import make_drive
 from .errors import ParameterError, check_positive, check_range
 from .scene import Scene
+
+install_mujoco_warnings()         # dm_control's import installed its own MuJoCo warning handler
 
 
 class BeamPhysics(engine.Physics):

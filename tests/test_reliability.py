@@ -384,7 +384,7 @@ def test_sigterm_ends_a_rollout_cleanly_with_its_outputs(tmp_path):
 
 def test_mujoco_warnings_become_python_warnings_without_a_log_file(tmp_path, monkeypatch):
     import mujoco
-    import mjeap  # noqa: F401  (installs the handler)
+    import mjeap.environment  # noqa: F401  (dm_control installs a handler of its own on import)
     monkeypatch.chdir(tmp_path)
     m = mujoco.MjModel.from_xml_string('<mujoco><worldbody><body><freejoint/><geom size="1"/></body></worldbody></mujoco>')
     d = mujoco.MjData(m)
