@@ -27,7 +27,6 @@ from dm_control.utils import rewards
 from dm_env import specs
 
 from . import install_mujoco_warnings
-
 from .discretize import Payload
 from .drives import make_drive
 from .errors import ParameterError, check_positive, check_range
