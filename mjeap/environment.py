@@ -188,8 +188,9 @@ def run_episode(env: control.Environment, policy: Callable, rrd=None):
     signals), written to ``rrd`` if given (also when the episode fails)."""
     from .analytical import arc_curvature
     from .recording import write_recording
-    from .rollout import RolloutResult
+    from .rollout import RolloutResult, check_outputs, write_outputs
 
+    check_outputs(rrd=rrd)
     physics, task = env.physics, env.task
     sc = physics.scene
     rows, error = [], None
@@ -227,5 +228,5 @@ def run_episode(env: control.Environment, policy: Callable, rrd=None):
                                None if (not rows or pay[0] is None) else np.array(pay),
                                {kk: np.array([s[kk] for s in sig]) for kk in keys}, None, meta)
         if rrd is not None and rows:
-            write_recording(rrd, result, sc)
+            write_outputs([(rrd, lambda: write_recording(rrd, result, sc))], error, result)
     return result
