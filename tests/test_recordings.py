@@ -106,3 +106,13 @@ def test_system_recording_has_a_group_per_actuator_and_every_body(tmp_path):
         assert f"/world/{n}/centreline" in rec
     assert "/world" in origins
     assert any(e.startswith("/world/bodies/ball/") for e in rec) and any(e.startswith("/world/bodies/world/") for e in rec)
+
+
+def test_environment_episode_recording_is_laid_out(tmp_path):
+    from mjeap.environment import make_environment, run_episode
+    env = make_environment("pedot-micro", time_limit=0.2, seed=0)
+    run_episode(env, policy=lambda ts: [0.5], rrd=tmp_path / "ep.rrd")
+    views = read_blueprint(tmp_path / "ep.rrd")
+    rec = read_recording(tmp_path / "ep.rrd")
+    assert all(covered(e, views) for e in rec if e.startswith("/plots/"))
+    assert {("TextDocument", "/meta"), ("3D", "/beam")} <= {(v["kind"], v["origin"]) for v in views}
