@@ -93,19 +93,7 @@ def _ts(origin: str, name: str, *series, contents=None):
     return rrb.TimeSeriesView(origin=origin, name=name, axis_y=y_axis(*series), **kw)
 
 
-def camera(points: np.ndarray):
-    """A 3D eye looking at the points' box from a raised diagonal, 1.6 x its size away."""
-    import rerun.blueprint as rrb
-    p = np.asarray(points, dtype=float).reshape(-1, 3)
-    p = p[np.isfinite(p).all(axis=1)]
-    lo, hi = p.min(axis=0), p.max(axis=0)
-    c, size = 0.5 * (lo + hi), max(float(np.linalg.norm(hi - lo)), 1e-9)
-    d = np.array([0.55, -0.75, 0.6])
-    return rrb.archetypes.EyeControls3D(position=c + 1.6 * size * d / np.linalg.norm(d), look_target=c,
-                                        eye_up=[0.0, 0.0, 1.0])
-
-
-def blueprint(result=None, scale: float = 1.0, grid_spacing: float = 1e-3, extra_views=(), eye=None):
+def blueprint(result=None, scale: float = 1.0, grid_spacing: float = 1e-3, extra_views=()):
     """The layout: the 3D beam (with a grid and the deformation scale in its title) over the
     run's parameters, beside a grid of time series, one quantity (one unit) per view, each
     with its y range fitted to the data."""
@@ -124,7 +112,9 @@ def blueprint(result=None, scale: float = 1.0, grid_spacing: float = 1e-3, extra
               _ts("/plots/tip_position/y", "tip deflection y (m)", tip[1]),
               rrb.Tabs(*drive_views, _ts("/plots/tip_angle", "tip angle (rad)", None if r is None else r.tip_angle),
                        _ts("/plots/tip_position/x", "tip axial x (m)", tip[0]), name="drive and tip")]
-    left = rrb.Vertical(rrb.Spatial3DView(origin="/beam", name=title, eye_controls=eye,
+    # Rerun's own camera frames the beam; an explicit EyeControls3D position was tried and
+    # rendered off target (headless, Rerun 0.41)
+    left = rrb.Vertical(rrb.Spatial3DView(origin="/beam", name=title,
                                           line_grid=rrb.archetypes.LineGrid3D(visible=True, spacing=grid_spacing)),
                         rrb.TextDocumentView(origin="/meta", name="run parameters and sources"),
                         row_shares=[3, 2])
@@ -172,9 +162,7 @@ def write_recording(path, result, scene, extra=None, views=(), deformation: floa
         shown = result.centreline[idx].copy()
         shown[..., 1:] *= scale                                      # magnified deflection
         shown = shown @ scene.rotation.T                             # (f, N + 2, 3), world axes
-    eye = camera(np.vstack([shown.reshape(-1, 3), [[-0.1 * L, 0, 0]]]) if shown is not None else
-                 np.array([[0, 0, 0], scene.rotation @ [L, 0, 0]]))
-    rec.save(str(path), default_blueprint=blueprint(result, scale, bar, views, eye))
+    rec.save(str(path), default_blueprint=blueprint(result, scale, bar, views))
     try:
         t = result.time
         R = scene.rotation  # clamp frame -> world

@@ -62,6 +62,8 @@ def render_one(path, png: Path, size: str = "1600x900", at_time: float = None, t
     """One recording in a fresh viewer (a viewer keeps the first blueprint it saw for an
     application), screenshot once everything has loaded."""
     path = Path(path).resolve()
+    if not path.is_file():
+        raise FileNotFoundError(f"no recording at {path}")
     state = tempfile.TemporaryDirectory()
     proc, viewer = _start(size, timeout, state.name)
     try:

@@ -99,7 +99,7 @@ def write_recording(ex: Experiment, path: Path, figure: Optional[Path] = None) -
     units), without matplotlib those curves as a table, and the simulated beams in 3D."""
     import rerun as rr
     import rerun.blueprint as rrb
-    from ..recording import camera, deformation_scale, y_axis
+    from ..recording import deformation_scale, y_axis
     panels = list(dict.fromkeys(c.panel for c in ex.curves))
     timed = [p for p in panels if any(c.xlabel.startswith("time") for c in ex.curves if c.panel == p)]
     untimed = [p for p in panels if p not in timed]
@@ -115,9 +115,7 @@ def write_recording(ex: Experiment, path: Path, figure: Optional[Path] = None) -
     if beams:
         # tiny motions (the piezo bimorphs) magnified as in the rollout recordings, and said so
         scale = min(deformation_scale(r, float(np.linalg.norm(r.centreline[0, -1]))) for _, r, _ in beams)
-        pts_all = np.vstack([r.centreline.reshape(-1, 3) @ (np.eye(3) if rot is None else np.asarray(rot)).T
-                             for _, r, rot in beams])
-        views.append(rrb.Spatial3DView(origin="/beams", eye_controls=camera(pts_all),
+        views.append(rrb.Spatial3DView(origin="/beams",
                                        name="simulated beams (m)" + ("" if scale == 1 else
                                                                      f", deformation shown x{scale:g}"),
                                        line_grid=rrb.archetypes.LineGrid3D(visible=True)))
