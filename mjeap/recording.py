@@ -24,7 +24,6 @@ post-processors do; the time series are always true values.
 """
 from __future__ import annotations
 
-import json
 import re
 from collections import OrderedDict
 from pathlib import Path

@@ -50,7 +50,7 @@ def why_not(scene, drive, controller=None) -> Optional[str]:
     reason = drive.closed_loop_reason()
     if reason is not None:
         return f"the {drive.name} drive is not open-loop: {reason}"
-    if scene._tip_force_world.any() or scene._tip_moment:
+    if scene.part.has_tip_load():
         return "a tip load is set on the scene (mujoco.rollout does not carry xfrc_applied)"
     return None
 
