@@ -28,6 +28,7 @@ import re
 from collections import OrderedDict
 from pathlib import Path
 
+import mujoco
 import numpy as np
 
 MAX_FRAMES = 2000
@@ -258,7 +259,7 @@ def read_blueprint(path) -> list:
 
 def _geom_archetype(rr, model, g: int, length: float, color):
     """A Rerun archetype drawing geom ``g`` in its body's frame (SI), or None."""
-    T = mujoco_types()
+    T = mujoco.mjtGeom
     t, size = model.geom_type[g], model.geom_size[g] * length
     pos = model.geom_pos[g] * length
     q = model.geom_quat[g]
@@ -269,22 +270,14 @@ def _geom_archetype(rr, model, g: int, length: float, color):
         return rr.Ellipsoids3D(half_sizes=[[size[0]] * 3], centers=[pos], colors=[color], fill_mode="solid")
     if t == T.mjGEOM_ELLIPSOID:
         return rr.Ellipsoids3D(half_sizes=[size], centers=[pos], quaternions=[rot], colors=[color], fill_mode="solid")
-    if t in (T.mjGEOM_CAPSULE, T.mjGEOM_CYLINDER):
+    if t == T.mjGEOM_CAPSULE:
         # MuJoCo: along the local z axis, half-length size[1], centred; Rerun: from the origin along +z
-        R = np.zeros(9)
-        import mujoco
-        mujoco.mju_quat2Mat(R, q)
-        start = pos - R.reshape(3, 3)[:, 2] * size[1]
-        cls = rr.Capsules3D if t == T.mjGEOM_CAPSULE else rr.Cylinders3D
-        if cls is rr.Capsules3D:
-            return cls(lengths=[2 * size[1]], radii=[size[0]], translations=[start], quaternions=[rot], colors=[color])
-        return cls(lengths=[2 * size[1]], radii=[size[0]], centers=[pos], rotations=[rot], colors=[color])
+        start = pos - _quat_mat(q)[:, 2] * size[1]
+        return rr.Capsules3D(lengths=[2 * size[1]], radii=[size[0]], translations=[start], quaternions=[rot],
+                             colors=[color])
+    if t == T.mjGEOM_CYLINDER:
+        return rr.Cylinders3D(lengths=[2 * size[1]], radii=[size[0]], centers=[pos], rotations=[rot], colors=[color])
     return None
-
-
-def mujoco_types():
-    import mujoco
-    return mujoco.mjtGeom
 
 
 def write_system_recording(path, result, system) -> Path:
@@ -382,7 +375,6 @@ def write_system_recording(path, result, system) -> Path:
 
 
 def _quat_mat(q) -> np.ndarray:
-    import mujoco
     R = np.zeros(9)
     mujoco.mju_quat2Mat(R, np.asarray(q, dtype=float))
     return R.reshape(3, 3)

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 import csv
 import math
+import os
 import sys
 import time as _time
 from dataclasses import dataclass, field
@@ -29,7 +30,7 @@ import mujoco
 import numpy as np
 
 from .analytical import arc_curvature
-from .errors import DivergenceError, ParameterError, check_positive, sigterm_as_interrupt
+from .errors import DivergenceError, ParameterError, check_positive, check_range, sigterm_as_interrupt
 from .scene import Scene
 from .waveforms import Waveform, parse_waveform
 
@@ -198,7 +199,6 @@ def check_sampling(wave, dt: float) -> None:
 def check_outputs(**paths) -> Dict[str, Path]:
     """The outputs a run will write (name -> path or None), checked before any work: distinct
     files, not directories, in a folder that exists or can be made and is writable."""
-    import os
     out, seen = {}, {}
     for name, p in paths.items():
         if p is None:
@@ -277,7 +277,6 @@ MAX_INITIAL_BEND = 2 * np.pi
 def check_initial_curvature(kappa, length: float, name: str = "initial_curvature") -> float:
     """A finite initial curvature (1/m) whose arc bends at most MAX_INITIAL_BEND over the
     beam (|kappa| L <= 2 pi: a full circle; more wraps the beam around itself)."""
-    from .errors import check_range
     return check_range(name, kappa, -MAX_INITIAL_BEND / length, MAX_INITIAL_BEND / length, "1/m")
 
 
@@ -364,21 +363,20 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
         meta["controller"] = getattr(controller, "name", type(controller).__name__)
     error = None
     wall0 = _time.perf_counter()
-    stop = sigterm_as_interrupt()
-    stop.__enter__()           # SIGTERM ends the run as Ctrl-C does: what was simulated is written
     try:
-        if engine == "threaded":
-            threaded.run(scene, [drv], [v_steps], [initial_curvature], sample_steps, [samples], nthread=0)
-        elif engine == "native":
-            threaded.run_native(scene, nat, [drv], [v_steps], [initial_curvature], sample_steps, [samples], nthread=0)
-        else:
-            _run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, progress, check_every,
-                      controller, meta)
+        with sigterm_as_interrupt():   # SIGTERM ends the run as Ctrl-C does: what was simulated is written
+            if engine == "threaded":
+                threaded.run(scene, [drv], [v_steps], [initial_curvature], sample_steps, [samples], nthread=0)
+            elif engine == "native":
+                threaded.run_native(scene, nat, [drv], [v_steps], [initial_curvature], sample_steps, [samples],
+                                    nthread=0)
+            else:
+                _run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, progress, check_every,
+                          controller, meta)
     except BaseException as e:  # record what was simulated, then re-raise
         error = e
         raise
     finally:
-        stop.__exit__(None, None, None)
         meta["wall_time_s"] = _time.perf_counter() - wall0
         result = samples.result(drv, initial_curvature, meta)
         if error is not None:

@@ -58,6 +58,13 @@ DEFAULT_MAX_BEND = 2.0
 DOF_DAMPING_FIELD = "mjeap_dof_damping"
 
 
+def diverged(data: mujoco.MjData) -> bool:
+    """MuJoCo warned of a bad acceleration, or the state is no longer finite (a sum is
+    finite only if every entry is, and no entry is near overflow)."""
+    return data.warning[mujoco.mjtWarning.mjWARN_BADQACC].number > 0 or \
+        not math.isfinite(float(data.qpos.sum()) + float(data.qvel.sum()))
+
+
 def _floor_sig(x: float, digits: int) -> float:
     e = np.floor(np.log10(x)) - (digits - 1)
     return float(np.floor(x / 10**e * (1 + 1e-12)) * 10**e)
@@ -289,11 +296,7 @@ class Scene:
         self.step(max(n, 1))
 
     def check_finite(self) -> None:
-        d = self.data
-        # a sum is finite only if every entry is (and no entry is near overflow)
-        bad = d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number > 0 or \
-            not math.isfinite(float(d.qpos.sum()) + float(d.qvel.sum()))
-        if bad:
+        if diverged(self.data):
             raise self.divergence_error()
 
     def divergence_error(self) -> DivergenceError:

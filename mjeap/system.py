@@ -31,7 +31,7 @@ import numpy as np
 from . import native
 from .component import ActuatorPart
 from .errors import DivergenceError, ParameterError, UnknownNameError, check_positive
-from .scene import DEFAULT_SEGMENTS, INTEGRATORS, Scene
+from .scene import DEFAULT_SEGMENTS, INTEGRATORS, Scene, diverged
 from .units import DEFAULT_UNITS, UnitSystem
 
 _PREFIX = re.compile(r"^[A-Za-z][A-Za-z0-9_-]*$")
@@ -367,10 +367,7 @@ class System:
         mujoco.mj_kinematics(self.model, self.data)
 
     def check_finite(self) -> None:
-        d = self.data
-        bad = d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number > 0 or \
-            not np.isfinite(float(d.qpos.sum()) + float(d.qvel.sum()))
-        if bad:
+        if diverged(self.data):
             raise DivergenceError(
                 f"system of {len(self)} actuators diverged by step {self._step_count} (t = {self.time:.6g} s): "
                 f"timestep {self.timestep:.4g} s ({self.timestep_reason}); check the host's bodies, joints and "
