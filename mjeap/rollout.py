@@ -480,6 +480,8 @@ def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable
     if not voltages:
         raise ParameterError("voltages", voltages, "at least one waveform")
     kappa0 = np.broadcast_to(np.asarray(initial_curvatures, dtype=float), (len(voltages),))
+    for k in kappa0:
+        check_initial_curvature(k, scene.layout.length, "initial_curvatures")
     drives = [make_drive(drive, scene, **(drive_params or {})) for _ in voltages]
     engine, _ = _choose_engine(engine, scene, drives[0], None)
     if engine == "loop":

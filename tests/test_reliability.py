@@ -393,3 +393,9 @@ def test_mujoco_warnings_become_python_warnings_without_a_log_file(tmp_path, mon
     with pytest.warns(RuntimeWarning, match="MuJoCo: .*internal units"):
         mujoco.mj_step(m, d)
     assert not (tmp_path / "MUJOCO_LOG.TXT").exists()
+
+
+def test_batches_check_initial_curvatures_as_rollout_does():
+    from mjeap import rollout_batch
+    with pytest.raises(ParameterError, match=r"initial_curvatures.*1/m"):
+        rollout_batch(Scene("pzt-hamr-small"), ["step:120V"], 1e-4, initial_curvatures=[float("nan")])
