@@ -402,25 +402,23 @@ class System:
         by prefix). Returns a :class:`SystemResult`; with ``rrd`` a Rerun recording (written
         also when the run fails: it then ends with the error). ``on_sample(system)`` is
         called at every sample (e.g. to move a mocap body)."""
-        from .rollout import _Samples, _sample_steps, _voltage_steps, _waveform, check_outputs, write_outputs
+        from .rollout import (_Samples, _sample_steps, _voltage_steps, _waveform, check_outputs, check_work,
+                              write_outputs)
         duration = check_positive("duration", duration, "s")
         check_outputs(rrd=rrd)
-        waves = self._per_actuator("voltages", voltages)
+        waves = [None if w is None else _waveform(w, duration) for w in self._per_actuator("voltages", voltages)]
         dt = self.timestep
-        from .rollout import check_work
         n_steps = check_work(duration, dt)
         v_steps = []
         for a, w in zip(self.actuators, waves):
             if a.drive is None:
                 if w is not None:
-                    raise ParameterError("voltages", w, f"None for the passive actuator '{a.prefix}'")
+                    raise ParameterError("voltages", getattr(w, "text", w), f"None for the passive actuator '{a.prefix}'")
                 v_steps.append(None)
                 continue
-            wave = None if w is None else _waveform(w, duration)
-            v = _voltage_steps(wave, duration, dt, a.drive) if wave is not None else \
-                np.full(n_steps, a.drive.rest_voltage())
-            a.drive.check_voltage(v)
-            v_steps.append(v)
+            # a waveform is checked against the drive's safe range there; the rest voltage is in it
+            v_steps.append(np.full(n_steps, a.drive.rest_voltage()) if w is None else
+                           _voltage_steps(w, duration, dt, a.drive))
         sample_steps = _sample_steps(n_steps, dt, sample_interval)
         ns = len(sample_steps)
         samples = [_Samples(p, ns) for p in self.parts]
@@ -428,14 +426,14 @@ class System:
         pos, quat, fc = np.empty((ns, nb, 3)), np.empty((ns, nb, 4)), np.empty((ns, nb, 3))
         m, d = self.model, self.data
         self.reset(initial_curvatures)
-        for a, v in zip(self.actuators, v_steps):
+        for a, p, v in zip(self.actuators, self.parts, v_steps):
             if v is not None:
                 a.drive.native_prepare(v)
-                a.drive.part = self.parts[self.actuators.index(a)]
+                a.drive.part = p
         active = [(i, v) for i, v in zip(self.actuator_ids, v_steps) if v is not None]
         meta = {"actuators": {a.prefix.rstrip("/"): {"actuator": a.twin.actuator.id,
                                                      "drive": None if a.drive is None else a.drive.describe(),
-                                                     "voltage": None if w is None else getattr(_waveform(w, duration), "text", str(w))}
+                                                     "voltage": None if w is None else getattr(w, "text", str(w))}
                               for a, w in zip(self.actuators, waves)},
                 "duration_s": duration, "steps": n_steps, "timestep_s": dt, "timestep_reason": self.timestep_reason,
                 "units": self.units.describe()}
