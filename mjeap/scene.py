@@ -3,12 +3,17 @@ loads, stepping with divergence checks, and SI read-outs.
 
 Damping and timestep are derived from the compiled model, never tuned by hand:
 
-1. Linearise (``mjeap.modes``) and find the first bending mode omega_1 of the scene
-   (payload and gravity included) and the highest discrete mode.
+1. Linearise (``mjeap.modes``) and find the first bending mode omega_1, phi_1 of the scene
+   (payload and gravity included), the first elastic mode omega_el (gravity's load left
+   out) and the highest discrete mode.
 2. Joint damping is stiffness-proportional (Rayleigh), b_j = beta k_j with
-   beta = 2 zeta_1 / omega_1, so the first mode has the catalog's damping ratio zeta_1 and
-   mode n has zeta_n = beta omega_n / 2: the stiff discrete modes are overdamped, as
-   material damping does to short wavelengths.
+   beta = 2 zeta_1 omega_1 / (phi_1' K_el phi_1) (phi_1 mass-normalised), so the first mode
+   has the catalog's damping ratio zeta_1 whatever gravity's geometric stiffness adds to or
+   takes from omega_1 (standing up, hanging, payloads); mode n has about
+   zeta_n = beta omega_n / 2: the stiff discrete modes are overdamped, as material damping
+   does to short wavelengths. Towards the buckling load omega_1 and with it beta go to zero;
+   past it the straight column's growth rate takes omega_1's place, so nothing jumps there
+   (both floored at 1 % of omega_el, ``NEAR_CRITICAL``).
 3. Under ``implicitfast`` joint damping is implicit but stiffness (joint springs and the
    cable plugin) is explicit, so the step must satisfy the stability limit h_stab of the
    linearised step map (about beta + sqrt(beta^2 + 4/omega_max^2), i.e. ~2 beta for a fine
@@ -19,10 +24,12 @@ Damping and timestep are derived from the compiled model, never tuned by hand:
    is still zeta_1, and its timestep is at most beta / 2 (the joint keeps at least half).
    ``discrete`` also solves contacts in the metric M + hD + h^2 K of the implicit update:
    systems with contact need it (:mod:`mjeap.system`).
-4. The default timestep is min(T_1 / 50, h_stab / 2): 50 steps per period of the first
-   mode keeps its period error below 0.1 %, the factor 2 keeps away from the limit, which
-   moves slightly with the large-deflection geometry. A user timestep above h_stab is
-   refused with the limit in the message.
+4. The default timestep is min(T_1 / 50, T_el / 50, h_stab / 2): 50 steps per period of
+   the first mode keeps its period error below 0.1 %; T_el bounds it near the buckling load,
+   where T_1 grows without bound but the beam's elastic response to a drive does not; the
+   factor 2 keeps away from the stability limit, which moves slightly with the
+   large-deflection geometry. A user timestep above h_stab is refused with the limit in the
+   message.
 """
 from __future__ import annotations
 
@@ -33,6 +40,7 @@ from typing import Optional, Sequence, Union
 
 import mujoco
 import numpy as np
+import scipy.linalg
 
 from . import analytical
 from .catalog import Actuator, get_actuator
@@ -49,6 +57,10 @@ SETTLING_DAMPING_RATIO = 0.3
 INTEGRATORS = {"implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
                "discrete": mujoco.mjtIntegrator.mjINT_DISCRETE}
 DEFAULT_SEGMENTS = 20
+#: the first mode's rate is floored at this fraction of the elastic first mode (gravity's
+#: load left out): within ~1e-4 of the buckling load its period would exceed 100 elastic
+#: periods, and a damping ratio of a mode that does not oscillate means nothing
+NEAR_CRITICAL = 0.01
 #: a payload heavier than this many beams is probably a unit slip (kg for mg, a factor 1e6):
 #: warned. The HAMR leg's reflected leg mass is 4.7e4 beams (controllers/hamr_leg.py)
 HEAVY_PAYLOAD = 1e5
@@ -93,7 +105,8 @@ class TimestepChoice:
     timestep: float               # s
     stability_limit: float        # s (inf: none)
     accuracy_limit: float         # s, T_1 / STEPS_PER_PERIOD
-    first_frequency: float        # Hz, scene's first bending mode (gravity included)
+    first_frequency: float        # Hz, scene's first bending mode (gravity included; past the
+                                  # buckling load the straight column's growth rate / 2 pi)
     highest_frequency: float      # Hz, highest discrete mode (elastic)
     damping_ratio: float          # zeta_1
     rayleigh_beta: float          # s, the first mode's whole stiffness-proportional damping
@@ -176,31 +189,45 @@ class Scene:
                 f"inertia {self.layout.link_inertia.min() / u.inertia:.3g} in these units; use e.g. the default "
                 f"(mm, mg, ms). MuJoCo said: {str(e).splitlines()[0]}") from None
         self.linearization = lin = linearize(model)
-        w2_tot = modal_frequencies(lin, with_gravity=True)
+        lam, phi = scipy.linalg.eigh(lin.K, lin.M)       # gravity included, mass-normalised
         w2_el = modal_frequencies(lin, with_gravity=False)
-        buckled = bool(w2_tot[0] <= 0)
-        w1 = np.sqrt(w2_tot[0] if not buckled else w2_el[0])
-        wmax = np.sqrt(w2_el[-1])
-        beta = 2 * zeta / w1
-        # Rayleigh damping D = beta K per degree of freedom. A ball joint takes one scalar
-        # damping in MJCF, so the cable's per-dof values (bending, in-plane, twist) travel in
-        # a custom numeric field that load_mjcf() and the scene apply after compiling.
-        dof_damping = beta * np.clip(np.diag(lin.K_elastic), 0.0, None)
+        buckled = bool(lam[0] <= 0)
+        w_el, wmax = np.sqrt(w2_el[0]), np.sqrt(w2_el[-1])
+        # the first mode's rate: its frequency below the buckling load, the growth rate of
+        # the straight column's unstable mode above it (near the load both go to zero like
+        # sqrt|1 - P/P_cr|, so nothing jumps there), floored at NEAR_CRITICAL x w_el
+        w1 = max(np.sqrt(abs(lam[0])), NEAR_CRITICAL * w_el)
+        # Rayleigh damping D = beta K_el per degree of freedom (clipped diagonal: a ball joint
+        # takes one scalar damping in MJCF, so the cable's per-dof values (bending, in-plane,
+        # twist) travel in a custom numeric field that load_mjcf() and the scene apply after
+        # compiling). The first mode phi_1 of K = K_el + K_gravity gets the modal damping
+        # beta phi_1' D_1 phi_1 = 2 zeta w1 with D_1 the pattern per unit beta, so beta is
+        # taken from that: with gravity's geometric stiffness in the frequency but not in
+        # the damping, 2 zeta / w1 would give zeta (w_el / w1)^2 (0.16 standing up, 0.03
+        # hanging with 100 mg on seed 000's beam).
+        pattern = np.clip(np.diag(lin.K_elastic), 0.0, None)
+        k1 = float(phi[:, 0] @ (pattern * phi[:, 0]))
+        beta = 2 * zeta * w1 / k1
+        dof_damping = beta * pattern
         kj = self.layout.hinge_stiffness / u.rotational_stiffness
         for j, name in enumerate(self.handles.joints):
             self.spec.joint(name).damping = [beta * kj[j], 0, 0]
         if self.representation != "hinge":
             self.spec.add_numeric(name=DOF_DAMPING_FIELD, data=list(dof_damping))
-        T1 = 2 * np.pi / w1
-        h_stab = stability_limit(lin, dof_damping, self.integrator, h_max=T1)
+        T1, T_el = 2 * np.pi / w1, 2 * np.pi / w_el
+        h_stab = stability_limit(lin, dof_damping, self.integrator, h_max=min(T1, T_el))
         if self.representation != "hinge":
             # the cable's tangent stiffness stops being diagonal in the joint coordinates
             # once bent (the stiff in-plane direction couples into twist), so diagonal
             # damping no longer damps it: check the design bend too
             bent = self._uniform_arc_qpos(model, self.max_bend)
             h_stab = min(h_stab, stability_limit(linearize(model, qpos=bent), dof_damping,
-                                                 self.integrator, h_max=T1))
-        h_acc = T1 / STEPS_PER_PERIOD
+                                                 self.integrator, h_max=min(T1, T_el)))
+        # accuracy: 50 steps per period of the first mode, and of the first mode without
+        # gravity's load (near the buckling load T1 grows without bound, the beam's elastic
+        # response to a drive or a push does not). The drives are discretised exactly
+        # (zero-order hold), so their time constants set no bound of their own.
+        h_acc = min(T1, T_el) / STEPS_PER_PERIOD
         # backward Euler on the hinge springs damps like Rayleigh damping with beta = h
         numerical = self.integrator == "discrete" and self.representation == "hinge"
         if numerical and beta > 0:
@@ -211,6 +238,7 @@ class Scene:
             h_si = min(h_acc, STABILITY_SAFETY * h_stab) * u.time
             h = _floor_sig(h_si, 3) / u.time
             reason = (f"min(T1/{STEPS_PER_PERIOD} = {T1 / STEPS_PER_PERIOD * u.time:.3g} s, "
+                      f"T_el/{STEPS_PER_PERIOD} = {T_el / STEPS_PER_PERIOD * u.time:.3g} s (no gravity load), "
                       f"{STABILITY_SAFETY} x stability limit {h_stab * u.time:.3g} s"
                       + (f", beta/2 = {0.5 * beta * u.time:.3g} s under discrete" if numerical and beta > 0 else "")
                       + ")")

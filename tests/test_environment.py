@@ -78,7 +78,9 @@ def test_bad_ranges_name_the_parameter():
 def test_episode_recording(tmp_path):
     env = short_env(seed=0)
     r = run_episode(env, lambda ts: np.array([0.5]), rrd=tmp_path / "ep.rrd")
-    assert r.time.size == 22 and np.isfinite(r.signals["reward (-)"][1:]).all()
+    # the first observation, then one per control step until time_limit is reached
+    steps = int(np.ceil(0.2 / env.control_timestep() - 1e-9))
+    assert r.time.size == steps + 1 and np.isfinite(r.signals["reward (-)"][1:]).all()
     ents = read_recording(tmp_path / "ep.rrd")
     assert "/beam/centreline" in ents and "/plots/drive/reward" in ents
 
