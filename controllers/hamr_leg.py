@@ -1,7 +1,7 @@
 """HAMR leg phase control from the actuator's own current (Jayaram et al. 2018, seed 003,
 section 6.2), written against mjeap's public API only.
 
-Scene: the HAMR small bimorph (alumina tip calibrated to its measured 1750 Hz) drives one
+Scene: the HAMR small bimorph (catalog residual tip mass fitted to its measured 1750 Hz) drives one
 leg degree of freedom through a transmission of ratio T (swing 13, lift 12): the foot moves
 T times the actuator tip. Linearised, a lever with a foot mass m_f reflects T^2 m_f onto the
 actuator tip, so the leg is a point mass there, sized so that the loaded first mode sits at
@@ -28,7 +28,7 @@ import numpy as np
 from scipy import optimize
 
 from mjeap import Scene, rollout
-from mjeap.calibration import calibrate_tip_extension
+from mjeap.catalog import get_actuator
 from mjeap.discretize import Payload
 from mjeap.drives import make_drive
 from mjeap.errors import ParameterError, check_positive
@@ -56,8 +56,9 @@ SWING = Transmission("swing", 13.0, 100.0, 0.0)
 
 
 def free_actuator():
-    """The HAMR small bimorph with its tip calibrated to the measured resonance."""
-    return calibrate_tip_extension(ACTUATOR, MEASURED_RESONANCE).actuator
+    """The HAMR small bimorph of the catalog: its residual tip mass is fitted to the measured
+    resonance (MEASURED_RESONANCE, mjeap.calibration.calibrate_tip_mass)."""
+    return get_actuator(ACTUATOR)
 
 
 def leg_scene(transmission: Transmission, actuator=None, **scene_kw) -> Scene:

@@ -32,12 +32,12 @@ from .scene import Scene, load_mjcf  # noqa: E402
 from .units import DEFAULT_UNITS, UnitSystem  # noqa: E402
 from . import analytical  # noqa: E402
 from .drives import DRIVES, Drive, register_drive  # noqa: E402
-from .rollout import RolloutResult, rollout, rollout_batch  # noqa: E402
+from .rollout import RolloutResult, free_vibration, rollout, rollout_batch  # noqa: E402
 from .waveforms import Waveform, parse_waveform  # noqa: E402
 
 __version__ = "0.1.0"
 __all__ = ["CATALOG", "Actuator", "Layer", "Planform", "get_actuator", "actuator_ids", "BeamLayout",
            "Payload", "discretize", "parse_quantity", "DivergenceError", "MjeapError", "ParameterError",
            "UnknownNameError", "REPRESENTATIONS", "build_spec", "Scene", "load_mjcf", "DEFAULT_UNITS",
-           "UnitSystem", "analytical", "DRIVES", "Drive", "register_drive", "RolloutResult", "rollout", "rollout_batch",
+           "UnitSystem", "analytical", "DRIVES", "Drive", "register_drive", "RolloutResult", "free_vibration", "rollout", "rollout_batch",
            "Waveform", "parse_waveform"]

@@ -350,16 +350,23 @@ class DadrasModel:
         return kap, reg
 
 
-def first_frequency_variable(L: float, EI, mass_per_length, guess: float) -> float:
+def first_frequency_variable(L: float, EI, mass_per_length, guess: float, tip_mass: float = 0.0,
+                             tip_offset: float = 0.0, tip_inertia: float = 0.0) -> float:
     """First bending frequency (Hz) of a clamped-free Euler-Bernoulli beam with EI(x) (N m^2)
     and m(x) (kg/m) given as callables, e.g. a tapered plate: (EI y'')'' = omega^2 m y solved
     as a boundary-value eigenproblem (scipy solve_bvp, omega^2 an unknown parameter, the
-    tip deflection normalised to 1). ``guess`` (Hz) selects the mode."""
+    tip deflection normalised to 1). ``guess`` (Hz) selects the mode.
+
+    A rigid body may sit on the tip (a tip block): ``tip_mass`` (kg) with its centre
+    ``tip_offset`` (m) past x = L along the tip's tangent and ``tip_inertia`` (kg m^2) about
+    its centre. Its inertia enters the free end's conditions (from the stationarity of
+    U - T): M(L) = omega^2 [m e (y + e y') + J y'] and V(L) = -omega^2 m (y + e y')."""
     L = check_positive("L", L, "m")
 
     EI0, m0 = float(EI(0.0)), float(mass_per_length(0.0))
     check_positive("EI(0)", EI0, "N m^2")
     check_positive("mass_per_length(0)", m0, "kg/m")
+    mu_t, e_t, j_t = tip_mass / (m0 * L), tip_offset / L, tip_inertia / (m0 * L**3)
 
     # nondimensional: x = L xi, EI = EI0 e(xi), m = m0 mu(xi), lam = omega^2 m0 L^4 / EI0
     def rhs(xi, u, p):
@@ -367,7 +374,10 @@ def first_frequency_variable(L: float, EI, mass_per_length, guess: float) -> flo
         return np.vstack([th, M / (EI(xi * L) / EI0), V, p[0] * (mass_per_length(xi * L) / m0) * y])
 
     def bc(u0, u1, p):
-        return np.array([u0[0], u0[1], u1[2], u1[3], u1[0] - 1.0])
+        y, th, M, V = u1
+        lam = p[0]
+        return np.array([u0[0], u0[1], M - lam * (mu_t * e_t * (y + e_t * th) + j_t * th),
+                         V + lam * mu_t * (y + e_t * th), y - 1.0])
 
     xi = np.linspace(0, 1, 100)
     lam = (2 * np.pi * guess) ** 2 * m0 * L**4 / EI0

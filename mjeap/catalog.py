@@ -13,7 +13,7 @@ from typing import Dict, Optional, Tuple
 
 import numpy as np
 
-from .errors import UnknownNameError, check_positive
+from .errors import ParameterError, UnknownNameError, check_positive
 from .section import SectionLayer, SectionProperties, multilayer_section
 
 SEED_000 = "Dadras et al. 2021, IEEE JMEMS 30(3) (seed 000)"
@@ -54,6 +54,15 @@ class Planform:
     extension_length: float = 0.0
     extension_mass: float = 0.0
     extension_source: str = "none"
+    #: labelled residual: mass (kg) added to the tip block at fixed length, calibrated to a
+    #: measured resonance (mjeap.calibration.calibrate_tip_mass); 0 = none
+    residual_tip_mass: float = 0.0
+    residual_source: str = "none"
+
+    @property
+    def tip_block_mass(self) -> float:
+        """Mass of the rigid tip block (kg): its material and the calibrated residual."""
+        return self.extension_mass + self.residual_tip_mass
 
     def width_at(self, x):
         """Planform width (m) at distance x (m) from the clamp."""
@@ -143,6 +152,9 @@ def validate_actuator(act: Actuator) -> Actuator:
             check_positive(f"{act.id}.{l.name}.{f}", getattr(l, f), unit)
         if l.width is not None:
             check_positive(f"{act.id}.{l.name}.width", l.width, "m")
+    if act.planform.extension_mass < 0 or act.planform.residual_tip_mass < 0:
+        raise ParameterError(f"{act.id}.planform.extension_mass", act.planform.extension_mass,
+                             "a non-negative tip-block mass (kg) and residual")
     for o in ("flexural_rigidity", "mass"):
         if getattr(act, o) is not None:
             check_positive(f"{act.id}.{o}", getattr(act, o).value, getattr(act, o).unit)
@@ -176,7 +188,7 @@ PEDOT_MICRO = Actuator(
     mass=Sourced(0.695e-6, "kg", SEED_000 + ", section IV: 0.695 +- 0.004 mg"),
     damping_ratio=Sourced(0.05, "-", "assumed (no value in the source)"),
     voltage_range=(-3.0, 3.0),
-    voltage_source=SEED_000 + ": operating voltages typically <= 3 V (electrolysis above)",
+    voltage_source=SEED_000 + ", section I: operating voltages typically <= 3 V (citing its ref. [26])",
 )
 
 # =========================================================================================
@@ -211,61 +223,89 @@ PPY_TRILAYER = Actuator(
 # =========================================================================================
 # Seed 002: P(VDF-TrFE-CTFE) five-layer unimorphs
 # =========================================================================================
-_T33 = "Table 3.3"
-_T34 = "Table 3.4"
 
 
-def _pvdf(id_: str, title: str, t_active: float, w_full: float, w_el: float) -> Actuator:
+def _pvdf(id_: str, title: str, t_active: float, w_full: float, w_el: float, slope_0v: float, table: str) -> Actuator:
+    """``slope_0v``: the sample's measured tip stiffness at 0 V (N/m), which sets its EI =
+    k L^3 / 3 (the layer model misses it by +23 / +7 / +95 %: adhesive layers and the clamp)."""
     src = SEED_002 + ", Tables 3.1, 3.3, 3.4"
+    L = 52e-3
     return Actuator(
         id=id_, title=title, document=SEED_002,
         layers=(
             Layer("kapton", "Kapton tape", 57e-6, w_full, 8.46e8, 0.34, 1420.0, source=src),
             Layer("electrode-bottom", "aluminium foil", 55e-6, w_el, 1.82e9, 0.33, 2700.0, source=src),
             Layer("terpolymer", "P(VDF-TrFE-CTFE)", t_active, w_full, 9.95e7, 0.33, 1780.0, source=src,
-                  sources={"density": SEED_002 + ", Table 3.3 (1.78 g/cm^3; Table 3.4 prints 1.7)"}),
+                  sources={"density": SEED_002 + ", Table 5.2 (1.78 g/cm^3; Table 3.4 prints 1.7)"}),
             Layer("electrode-top", "aluminium foil", 55e-6, w_el, 1.82e9, 0.33, 2700.0, source=src),
             Layer("pe-tape", "PE adhesive tape", 50e-6, w_full, 4.66e8, 0.46, 920.0, source=src),
         ),
         planform=Planform(length=52e-3, base_width=w_full, tip_width=w_full,
                           source=SEED_002 + ", Table 3.4 (free length 52 mm; 10 mm more in the clamp)"),
+        flexural_rigidity=Sourced(slope_0v * L**3 / 3, "N m^2",
+                                  f"identified: 3 EI / L^3 = the measured 0 V load-displacement slope "
+                                  f"{slope_0v * 1e-3:.3g} N/mm ({SEED_002}, {table}); the layer model (eqs. 3.1-3.6) "
+                                  f"stays available as section_at()"),
         damping_ratio=Sourced(0.05, "-", "assumed (no value in the source)"),
         voltage_range=(-15e6 * t_active, 15e6 * t_active),
         voltage_source=SEED_002 + ": fields up to 15 MV/m tested (Table 4.6); electrostriction is even in V",
     )
 
 
-PVDF_60 = _pvdf("pvdf-60", "60PVDF five-layer unimorph, 52 x 15 mm, 60 um terpolymer", 60e-6, 15e-3, 14e-3)
-PVDF_60_HALF = _pvdf("pvdf-60-half", "60PVDFHalf five-layer unimorph, 52 x 8 mm, 60 um terpolymer", 60e-6, 8e-3, 7e-3)
-PVDF_130 = _pvdf("pvdf-130", "130PVDF five-layer unimorph, 52 x 15 mm, 130 um terpolymer", 130e-6, 15e-3, 14e-3)
+PVDF_60 = _pvdf("pvdf-60", "60PVDF five-layer unimorph, 52 x 15 mm, 60 um terpolymer", 60e-6, 15e-3, 14e-3,
+                0.470, "Table 4.1")
+PVDF_60_HALF = _pvdf("pvdf-60-half", "60PVDFHalf five-layer unimorph, 52 x 8 mm, 60 um terpolymer", 60e-6, 8e-3, 7e-3,
+                     0.280, "Table 4.2")
+PVDF_130 = _pvdf("pvdf-130", "130PVDF five-layer unimorph, 52 x 15 mm, 130 um terpolymer", 130e-6, 15e-3, 14e-3,
+                 0.600, "Table 4.3")
 
 # =========================================================================================
 # Seed 003: PZT-5H bimorphs (HAMR, RoboBee)
 # =========================================================================================
-_PZT_E = "literature default: PZT-5H Y11E ~ 62 GPa (manufacturer data; Erturk & Inman app. E)"
+# Physical parameter set. Table 1's f_r are unloaded clamped-free resonances, so nothing but
+# the actuator itself is modelled. Moduli: the effective (large-signal average) values that
+# Harvard's own HAMR actuator model uses for these bimorphs, not PZT-5H's small-signal 62 GPa.
+_HAMR_MODEL = ("Jafferis et al. 2015, Smart Mater. Struct. 24 065023, as used by Harvard's HAMR actuator "
+               "model (HarvardAgileRoboticsLab/drake, examples/HAMR-URDF/dev/Actuator/PZTBender2.m)")
+_PZT_E = f"effective average modulus under drive, 40 GPa ({_HAMR_MODEL}; small-signal Y11E is 62 GPa)"
 _PZT_RHO = "literature default: PZT-5H 7500 kg/m^3 (manufacturer data)"
-_CF = "literature default: ultra-high-modulus carbon fibre ~ 300 GPa, 1550 kg/m^3"
+_CF_E = f"high-modulus carbon fibre 340 GPa ({_HAMR_MODEL})"
+_CF_RHO = "literature default: carbon-fibre/epoxy ~ 1550 kg/m^3"
+_T1 = SEED_003 + ", Table 1 caption (total 320 um, each PZT layer 135 um)"
+#: alumina density, literature default (kg/m^3)
+ALUMINA_DENSITY = 3900.0
+_ALUMINA = f"alumina, {ALUMINA_DENSITY:g} kg/m^3 (literature default), tip width x full thickness"
+_TIP_HAMR = f"1.0 mm alumina tip ({_HAMR_MODEL}: lext = 1 mm on the 9.2 mm HAMR actuator)"
+_TIP_HAMR_LARGE = _TIP_HAMR + "; assumed the same for Type I (no published value)"
+_TIP_ROBOBEE = ("2.25 mm alumina tip: extension ratio 0.25 on the 9 mm RoboBee actuator (Jafferis et al. 2015 "
+                "design rules, as in public design code with Table 1's Type III widths; secondary source)")
+#: calibrated residual per type: tip-block mass at fixed length that brings the first mode to
+#: Table 1's f_r (mjeap.calibration.calibrate_tip_mass; tests/test_pzt_fidelity.py re-fits it)
+_RESIDUAL_SRC = ("calibrated residual: extra tip-block mass at fixed block length fitted to the Table 1 "
+                 "resonance (mjeap.calibration.calibrate_tip_mass); leaves the static gains unchanged")
 
 
-def _pzt(id_: str, title: str, w_tip: float, w_base: float, length: float, row: str) -> Actuator:
-    src = SEED_003 + ", section 2 (two 135 um PZT-5H plates on carbon fibre, 320 um total)"
-    pzt = dict(youngs_modulus=62e9, poisson_ratio=0.31, density=7500.0, source=src,
+def _pzt(id_: str, title: str, w_tip: float, w_base: float, length: float, row: str, tip_length: float,
+         tip_source: str, residual_mass: float) -> Actuator:
+    pzt = dict(youngs_modulus=40e9, poisson_ratio=0.31, density=7500.0, source=_T1,
                sources={"youngs_modulus": _PZT_E, "density": _PZT_RHO,
                         "poisson_ratio": "literature default (0.31, manufacturer data)"})
+    block = ALUMINA_DENSITY * w_tip * 320e-6 * tip_length
     return Actuator(
         id=id_, title=title, document=SEED_003,
         layers=(
             Layer("pzt-bottom", "PZT-5H", 135e-6, None, **pzt),
-            Layer("carbon-fibre", "carbon fibre (UHM)", 50e-6, None, 300e9, 0.3, 1550.0,
-                  source=src + "; thickness = 320 - 2 x 135 um",
-                  sources={"youngs_modulus": _CF, "density": _CF,
+            Layer("carbon-fibre", "carbon fibre (UHM)", 50e-6, None, 340e9, 0.3, 1550.0,
+                  source=_T1 + "; thickness = 320 - 2 x 135 um",
+                  sources={"youngs_modulus": _CF_E, "density": _CF_RHO,
                            "poisson_ratio": "literature default (0.3)"}),
             Layer("pzt-top", "PZT-5H", 135e-6, None, **pzt),
         ),
         planform=Planform(length=length, base_width=w_base, tip_width=w_tip,
                           source=SEED_003 + f", Table 1 ({row})",
-                          extension_length=0.0, extension_mass=0.0,
-                          extension_source="unknown in the source (alumina tip); 0 until calibrated"),
+                          extension_length=tip_length, extension_mass=block,
+                          extension_source=f"{tip_source}; mass: {_ALUMINA}",
+                          residual_tip_mass=residual_mass, residual_source=_RESIDUAL_SRC),
         damping_ratio=Sourced(0.05, "-", "assumed (no value in the source)"),
         voltage_range=(0.0, 200.0),
         voltage_source=SEED_003 + ": unipolar drive, V_sig in [0, V_bias], bias 25-200 V",
@@ -274,9 +314,12 @@ def _pzt(id_: str, title: str, w_tip: float, w_base: float, length: float, row: 
     )
 
 
-PZT_HAMR_LARGE = _pzt("pzt-hamr-large", "PZT-5H bimorph Type I (HAMR, large)", 1.35e-3, 7.75e-3, 10e-3, "Type I")
-PZT_HAMR_SMALL = _pzt("pzt-hamr-small", "PZT-5H bimorph Type II (HAMR, small)", 1.75e-3, 5.25e-3, 9.2e-3, "Type II")
-PZT_ROBOBEE = _pzt("pzt-robobee", "PZT-5H bimorph Type III (RoboBee)", 0.5e-3, 1.75e-3, 9e-3, "Type III")
+PZT_HAMR_LARGE = _pzt("pzt-hamr-large", "PZT-5H bimorph Type I (HAMR, large)", 1.35e-3, 7.75e-3, 10e-3, "Type I",
+                      1.0e-3, _TIP_HAMR_LARGE, 10.18e-6)
+PZT_HAMR_SMALL = _pzt("pzt-hamr-small", "PZT-5H bimorph Type II (HAMR, small)", 1.75e-3, 5.25e-3, 9.2e-3, "Type II",
+                      1.0e-3, _TIP_HAMR, 1.835e-6)
+PZT_ROBOBEE = _pzt("pzt-robobee", "PZT-5H bimorph Type III (RoboBee)", 0.5e-3, 1.75e-3, 9e-3, "Type III",
+                   2.25e-3, _TIP_ROBOBEE, 7.111e-6)
 
 CATALOG: Dict[str, Actuator] = {a.id: validate_actuator(a) for a in (
     PEDOT_MICRO, PPY_TRILAYER, PVDF_60, PVDF_60_HALF, PVDF_130,

@@ -53,7 +53,8 @@ def describe(name: str) -> dict:
         "planform": {"length": (p.length, "m", p.source), "base_width": (p.base_width, "m", p.source),
                      "tip_width": (p.tip_width, "m", p.source),
                      "extension_length": (p.extension_length, "m", p.extension_source),
-                     "extension_mass": (p.extension_mass, "kg", p.extension_source)},
+                     "extension_mass": (p.extension_mass, "kg", p.extension_source),
+                     "residual_tip_mass": (p.residual_tip_mass, "kg", p.residual_source)},
         "overrides": {k: (getattr(a, k).value, getattr(a, k).unit, getattr(a, k).source)
                       for k in ("flexural_rigidity", "mass") if getattr(a, k) is not None},
         "damping_ratio": (a.damping_ratio.value, "-", a.damping_ratio.source),
@@ -209,7 +210,8 @@ def add_scene_args(p: argparse.ArgumentParser) -> None:
     p.add_argument("name", help="catalog id (see `mjeap list`)")
     p.add_argument("--segments", type=int, default=DEFAULT_SEGMENTS, help="number of segments (>= 2)")
     p.add_argument("--representation", choices=REPRESENTATIONS, default="hinge")
-    p.add_argument("--payload", help="tip payload MASS@POSITION, e.g. 12.6mg@6.27mm")
+    p.add_argument("--payload", help="tip payload MASS@POSITION[,point|,r=RADIUS|,I=INERTIA], e.g. 12.6mg@6.27mm "
+                   "(NdFeB sphere) or 12.6mg@6.27mm,point (no rotary inertia)")
     p.add_argument("--orientation", choices=ORIENTATIONS, default="horizontal")
     p.add_argument("--timestep", type=float, help="timestep in s (default: chosen from the model)")
     p.add_argument("--integrator", choices=list(INTEGRATORS), default="implicitfast")

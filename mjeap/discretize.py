@@ -30,40 +30,69 @@ MAX_PAYLOAD_OVERHANG = 0.25
 class Payload:
     """A rigid tip payload: ``mass`` (kg) centred ``position`` (m) from the clamp along the
     beam (seed 000's effective length l_e; it may sit on a rigid tip extension and overhang
-    the tip by up to 25 % of L, a magnet stuck on the tip). ``radius`` (m) of the sphere giving its rotary inertia; by
-    default that of an NdFeB sphere of the same mass."""
+    the tip by up to 25 % of L, a magnet stuck on the tip). Its rotary inertia about its
+    centre (kg m^2): ``inertia`` if given (0 is a point mass, :meth:`point`), else that of a
+    solid sphere of ``radius`` (m), by default an NdFeB sphere of the same mass."""
 
     mass: float
     position: float
     radius: Optional[float] = None
+    rotary_inertia: Optional[float] = None
 
     def __post_init__(self):
         check_positive("payload.mass", self.mass, "kg")
         check_positive("payload.position", self.position, "m")
         if self.radius is not None:
             check_positive("payload.radius", self.radius, "m")
+        if self.rotary_inertia is not None:
+            check_range("payload.inertia", self.rotary_inertia, 0.0, np.inf, "kg m^2")
+            if self.radius is not None:
+                raise ParameterError("payload", f"radius={self.radius}, inertia={self.rotary_inertia}",
+                                     "a radius or an inertia, not both")
+
+    @classmethod
+    def point(cls, mass: float, position: float) -> "Payload":
+        """A point mass (kg) at ``position`` (m): no rotary inertia."""
+        return cls(mass, position, rotary_inertia=0.0)
 
     @property
     def sphere_radius(self) -> float:
+        """Radius (m) of the sphere drawn for it (and giving its inertia unless one is set)."""
         if self.radius is not None:
             return self.radius
         return (3 * self.mass / (4 * np.pi * PAYLOAD_DENSITY)) ** (1 / 3)
 
     @property
     def inertia(self) -> float:
-        """Rotary inertia about its centre (kg m^2), solid sphere."""
+        """Rotary inertia about its centre (kg m^2)."""
+        if self.rotary_inertia is not None:
+            return self.rotary_inertia
         return 0.4 * self.mass * self.sphere_radius**2
 
     @staticmethod
     def parse(text: str) -> "Payload":
-        """Parse ``MASS@POSITION`` with units, e.g. ``12.6mg@6.27mm`` (SI if no unit)."""
+        """Parse ``MASS@POSITION[,point|,r=RADIUS|,I=INERTIA]`` with units, e.g.
+        ``12.6mg@6.27mm`` (NdFeB sphere), ``12.6mg@6.27mm,point`` (no rotary inertia),
+        ``12.6mg@6.27mm,r=1mm`` or ``12.6mg@6.27mm,I=2e-12`` (kg m^2); SI if no unit."""
+        usage = "MASS@POSITION[,point|,r=RADIUS|,I=INERTIA kg m^2], e.g. 12.6mg@6.27mm or 12.6mg@6.27mm,point"
         try:
-            m, p = text.split("@")
-            return Payload(parse_quantity(m, "kg"), parse_quantity(p, "m"))
+            head, *opts = [t.strip() for t in text.split(",")]
+            m, p = head.split("@")
+            kw = {}
+            for o in opts:
+                if o == "point":
+                    kw["rotary_inertia"] = 0.0
+                elif o.startswith("r="):
+                    kw["radius"] = parse_quantity(o[2:], "m")
+                elif o.startswith("I="):
+                    kw["rotary_inertia"] = float(o[2:])
+                else:
+                    raise ValueError(o)
+            return Payload(parse_quantity(m, "kg"), parse_quantity(p, "m"), **kw)
         except ValueError as e:
             if isinstance(e, ParameterError):
                 raise
-            raise ParameterError("payload", text, "MASS@POSITION, e.g. 12.6mg@6.27mm") from None
+            raise ParameterError("payload", text, usage) from None
 
 
 _PREFIX = {"": 1.0, "k": 1e3, "M": 1e6, "m": 1e-3, "u": 1e-6, "µ": 1e-6, "n": 1e-9}
@@ -160,7 +189,7 @@ def discretize(act: Actuator, segments: int) -> BeamLayout:
         hinge_x=hx, hinge_stiffness=EI / ds, hinge_width=np.asarray(act.width_at(hx), dtype=float),
         link_start=start, link_end=end, link_mass=np.array(mass), link_com=np.array(com),
         link_inertia=np.array(inertia), link_width=np.array(width),
-        extension_length=act.planform.extension_length, extension_mass=act.planform.extension_mass,
+        extension_length=act.planform.extension_length, extension_mass=act.planform.tip_block_mass,
         poisson_ratio=nu,
     )
 

@@ -104,7 +104,9 @@ class CurvatureTrackingTask(base.Task):
             mass = float(self.random.uniform(*self.payload_mass_range))
             u = sc.units
             m.body_mass[sc.payload_id] = mass / u.mass
-            m.body_inertia[sc.payload_id] = Payload(mass, sc.payload.position, sc.payload.sphere_radius).inertia / u.inertia
+            p = sc.payload   # same sphere (or the same given inertia) with the new mass
+            m.body_inertia[sc.payload_id] = (p.rotary_inertia if p.rotary_inertia is not None else
+                                             Payload(mass, p.position, p.sphere_radius).inertia) / u.inertia
             mujoco.mj_setConst(m, physics.data.ptr)
             self.episode["payload_mass_kg"] = mass
         kappa0 = float(self.random.uniform(*self.initial_curvature_range))

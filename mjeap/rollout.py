@@ -460,6 +460,13 @@ def _run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, pro
                     "(reference beyond reach or gains too high)")
 
 
+def free_vibration(scene: Scene, curvature: float, duration: float, **kw) -> RolloutResult:
+    """Release the beam, bent to a uniform arc of ``curvature`` (1/m), with no drive holding
+    it, and follow it for ``duration`` s: a free vibration under its elasticity, damping,
+    gravity and loads (the ``none`` drive). Keywords as :func:`rollout`."""
+    return rollout(scene, "step:0V", duration, drive="none", initial_curvature=curvature, **kw)
+
+
 def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable]], duration: float,
                   drive: Optional[str] = None, drive_params: Optional[dict] = None,
                   initial_curvatures: Union[float, Sequence[float]] = 0.0,

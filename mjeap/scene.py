@@ -282,6 +282,20 @@ class Scene:
         self._data = data
         self.part.bind(data)
 
+    # ------------------------------------------------------------------ the beam, SI
+    @property
+    def length(self) -> float:
+        """Free (active) length L of the beam (m), without a rigid tip block."""
+        return self.layout.length
+
+    def flexural_rigidity(self, x) -> np.ndarray:
+        """EI (N m^2) of the continuum beam at ``x`` (m from the clamp, scalar or array); the
+        hinge j carries EI(x_j) / ds of it (``hinge_stiffness``)."""
+        x = np.asarray(x, dtype=float)
+        if np.any(x < 0) or np.any(x > self.layout.length):
+            raise ParameterError("x", x, f"positions in [0, {self.layout.length:g}] m (the free length)")
+        return self.actuator.flexural_rigidity_at(x).reshape(x.shape)
+
     # ------------------------------------------------------------------ state
     @property
     def timestep(self) -> float:

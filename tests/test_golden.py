@@ -12,6 +12,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from mjeap.drives.electrostrictive import STRAIN_COEFFICIENT
+
 from mjeap.rollout import rollout
 from mjeap.scene import Scene
 from mjeap.validation import golden
@@ -29,10 +31,10 @@ def test_tip_curvature_matches_golden(actuator_id):
 
 
 def test_golden_tolerance_catches_a_small_physics_change():
-    """A 0.1 % change of the terpolymer's permittivity (moment +0.1 %) must fail the check."""
+    """A 0.1 % change of the terpolymer's strain coefficient (moment +0.1 %) must fail the check."""
     kw, wave, duration, k0, params = golden.SCENARIOS["pvdf-60"]
     t_ref, k_ref = golden.read(FOLDER, "pvdf-60")
-    r = rollout(Scene("pvdf-60", **kw), wave, duration, drive_params={"relative_permittivity": 45.045},
+    r = rollout(Scene("pvdf-60", **kw), wave, duration, drive_params={**params, "strain_coefficient": 1.001 * STRAIN_COEFFICIENT},
                 progress=False, sample_interval=duration / golden.SAMPLES)
     dev = np.max(np.abs(r.tip_curvature - k_ref)) / np.ptp(k_ref)
     assert dev > 10 * golden.RTOL

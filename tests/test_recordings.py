@@ -30,7 +30,7 @@ def series_names(rec, entity):
     ("pedot-micro", "square:1V@0.5Hz", 2.0, {}),                       # native rc-relaxation
     ("pzt-hamr-small", "sine:50V@200Hz,offset=100V", 0.01, {}),        # tiny motion: magnified
     ("ppy-trilayer", "square:0.5V@0.5Hz", 2.0, {}),
-    ("pvdf-60", "step:600V", 0.1, {}),                                 # loop, field stiffening
+    ("pvdf-60", "step:600V", 0.1, {"stiffening": True}),               # loop, field stiffening
 ])
 def test_rollout_recording_lays_out_every_signal(tmp_path, actuator, wave, duration, params):
     path = tmp_path / "r.rrd"

@@ -43,7 +43,8 @@ def test_tip_stiffness_against_thesis_model_slopes():
 def test_symmetric_bimorph_matches_wood_formula():
     """Wood et al. 2005: D = (1/3) E_p t_p (1.5 t_cf^2 + 3 t_cf t_p + 2 t_p^2) + E_cf t_cf^3 / 12 per width."""
     a = PZT_HAMR_LARGE
-    Ep, tp, Ecf, tcf = 62e9, 135e-6, 300e9, 50e-6
+    Ep, tp = a.layers[0].youngs_modulus, a.layers[0].thickness
+    Ecf, tcf = a.layers[1].youngs_modulus, a.layers[1].thickness
     D = Ep * tp * (1.5 * tcf**2 + 3 * tcf * tp + 2 * tp**2) / 3 + Ecf * tcf**3 / 12
     for x in (0.0, 0.5 * a.length, a.length):
         s = a.section_at(x)

@@ -50,12 +50,14 @@ def test_convergence_is_second_order(representation):
 
 
 def test_tapered_bimorph_matches_nonuniform_beam_theory():
-    """Trapezoidal PZT bimorph (EI linear in x): small tip force deflection against
-    w(L) = P int_0^L (L - x)^2 / EI(x) dx (Castigliano), quadrature by scipy."""
+    """Trapezoidal PZT bimorph (EI linear in x) with its rigid tip block: small force at the
+    block's end, deflection there against P int_0^L (L + l_ext - x)^2 / EI(x) dx (Castigliano),
+    quadrature by scipy."""
     from scipy.integrate import quad
     s = Scene("pzt-hamr-large")
     act = s.actuator
     P = 1e-3
-    ref = P * quad(lambda x: (act.length - x) ** 2 / act.flexural_rigidity_at(x)[0], 0, act.length)[0]
+    end = act.length + act.planform.extension_length
+    ref = P * quad(lambda x: (end - x) ** 2 / act.flexural_rigidity_at(x)[0], 0, act.length)[0]
     tip = settled_tip(s, force=P)
     assert tip[1] == pytest.approx(ref, rel=0.005)

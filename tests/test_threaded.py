@@ -56,7 +56,7 @@ def test_auto_picks_threaded_only_where_it_applies():
 
 @pytest.mark.parametrize("actuator,params,words", [
     ("pedot-micro", {}, "back-relaxation"),
-    ("pvdf-60", {}, "stiffening"),
+    ("pvdf-60", {"stiffening": True}, "stiffening"),
     ("ppy-trilayer", {"stiffness_table": [(0.0, 1.0), (1.0, 1.5)]}, "stiffness table")])
 def test_closed_loop_drives_are_refused_with_the_reason(actuator, params, words):
     s = Scene(actuator)

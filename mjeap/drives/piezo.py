@@ -8,7 +8,8 @@ Jafferis et al. 2015): at a section of width w,
     M = (1/2) f31 w (t_p + t_cf) V_eff,
 
 so the curvature M / (D w) is uniform even on the trapezoidal planform; with a rigid tip
-extension l_ext the free deflection is (1/4)(1 + 2 l_ext/L) f31 V (t_p + t_cf) L^2 / D.
+block of length l_ext the free deflection at its end is (1/4)(1 + 2 l_ext/L) f31 V
+(t_p + t_cf) L^2 / D.
 
 Actuator current, eq. (1): I = (2 V_sig - V_bias) / (2 R) + C dV_sig/dt + I_mech. The
 motional current is the reciprocal of the moment: I_mech = sum_j Gamma_j dtheta_j/dt with
@@ -135,13 +136,15 @@ class PiezoBimorphDrive(Drive):
             self.bending_stiffness_per_width()
 
     def blocked_force(self, v_eff: float) -> float:
-        """(3/4)(w_n/L) f31 (t_p + t_cf) V G_F with w_n the base width and the taper factor
-        G_F = (L^3 / (3 w_n)) / int_0^L (L - x)^2 / w(x) dx (ratio of the tip compliances
-        of a rectangular and the trapezoidal plate, evaluated with scipy quad)."""
+        """(3/4)(w_n/L) f31 (t_p + t_cf) V G_F (N) at the end of the rigid tip block, w_n the
+        base width and G_F = (1 + 2 l_r) (L^3 / (3 w_n)) / int_0^L (L (1 + l_r) - x)^2 / w(x) dx
+        the geometry factor of the trapezoid with its extension (Wood/Jafferis; the ratio of
+        the free deflection to the tip compliance, evaluated with scipy quad)."""
         from scipy.integrate import quad
         act = self.scene.actuator
         L, wn = act.length, act.planform.base_width
-        GF = (L**3 / (3 * wn)) / quad(lambda x: (L - x) ** 2 / float(act.width_at(x)), 0, L)[0]
+        lr = act.planform.extension_length / L
+        GF = (1 + 2 * lr) * (L**3 / (3 * wn)) / quad(lambda x: (L * (1 + lr) - x) ** 2 / float(act.width_at(x)), 0, L)[0]
         return 0.75 * wn / L * self.params["f31"] * (self.t_p + self.t_cf) * v_eff * GF
 
     def reference_curvature(self, t, v, initial_curvature=0.0):

@@ -121,14 +121,14 @@ def buckling(quick: bool = False) -> Experiment:
         sc = Scene(ACT, orientation="up", payload=Payload(factor * P_cr / G, L))
         sc.set_hinge_angles(np.full(sc.layout.segments, 1e-3 / sc.layout.segments))  # small push
         y0 = abs(sc.tip_position()[1])
-        sc.run(3.0)
+        sc.settle(tol=1e-9)     # run to rest (first-mode damping raised to 0.3 while settling)
         tip = sc.tip_position()
         if factor < 1:
-            ex.check(f"{factor:g} P_cr: lateral tip deflection 3 s after a small push", "m", abs(tip[1]), 0.0,
+            ex.check(f"{factor:g} P_cr: lateral tip deflection at rest after a small push", "m", abs(tip[1]), 0.0,
                      "stable column returns straight (tolerance: 1 % of the push)", tolerance=0.01 * y0,
                      error_kind="absolute")
         else:
-            ex.beam(f"{factor:g} P_cr: post-buckled after 3 s", sc)
+            ex.beam(f"{factor:g} P_cr: post-buckled, at rest", sc)
             x_ref, d_ref, _ = an.postbuckled_column(factor, L)
             ex.check(f"{factor:g} P_cr: post-buckled tip deflection", "m", abs(tip[1]), d_ref,
                      "post-buckled elastica (elliptic integrals)", tolerance=0.03)
@@ -148,10 +148,14 @@ def section(quick: bool = False) -> Experiment:
     ex.check("neutral axis z_c", "m", s.neutral_axis, 0.132e-3, "Metello 2020 (seed 002), sec. 3.3", tolerance=0.01)
     ex.check("flexural rigidity EI", "N m^2", s.flexural_rigidity, 2.703e-5, "Metello 2020 (seed 002), sec. 3.3",
              tolerance=0.01)
-    sc = Scene("pvdf-60", gravity=False)
+    # the layer model's beam (the catalog's pvdf-60 takes its EI from the measured 0 V slope)
+    from dataclasses import replace
+    sc = Scene(replace(PVDF_60, flexural_rigidity=None), gravity=False)
     P = 1e-5
     tip = settled(sc, force=P)
-    ex.beam("60PVDF under a 10 uN tip force (deflection as computed)", sc)
-    ex.check("simulated 52 mm beam: tip compliance", "m/N", tip[1] / P, sc.layout.length**3 / (3 * 2.703e-5),
-             "L^3 / (3 EI) with the thesis EI", tolerance=0.01)
+    ex.beam("60PVDF (layer model) under a 10 uN tip force (deflection as computed)", sc)
+    ex.check("simulated 52 mm beam, layer-model EI: tip compliance", "m/N", tip[1] / P,
+             sc.layout.length**3 / (3 * 2.703e-5), "L^3 / (3 EI) with the thesis EI", tolerance=0.01)
+    ex.notes.append("The catalog's pvdf-60 uses the EI identified from its measured 0 V slope (23 % below this "
+                    "layer model, see metello2020); this experiment checks the layer model itself.")
     return ex
