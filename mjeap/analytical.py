@@ -13,7 +13,7 @@ from dataclasses import dataclass
 from typing import Tuple
 
 import numpy as np
-from scipy import integrate, optimize
+from scipy import integrate, optimize, signal
 
 from .errors import ParameterError, check_positive
 from .section import SectionLayer, SectionProperties, multilayer_section  # noqa: F401  (re-export)
@@ -306,6 +306,31 @@ class DadrasModel:
     def marginal_mass(self, l_e: float) -> float:
         """Payload mass (kg) at which the Region 3 pole reaches the origin."""
         return 3 * self.pole / (2 * self.mechanical_gain * self.zero * self.gravity * l_e**2)
+
+    def free_curvature(self, t: np.ndarray, v: np.ndarray) -> np.ndarray:
+        """Curvature (1/m) of the unloaded beam at the uniform sample times ``t`` (s) for the
+        voltage samples ``v`` (V, held between samples), from rest: eq. (8) by scipy lsim."""
+        tf = signal.TransferFunction([self.k_tf, self.k_tf * self.zero],
+                                     np.polymul([1.0, self.pole], [1.0, self.electrical_pole]))
+        return signal.lsim(tf, np.asarray(v, float), np.asarray(t, float), interp=False)[1]
+
+    def grip_force(self, t: np.ndarray, v: np.ndarray, a: float, gap: float) -> np.ndarray:
+        """Contact force (N) of this actuator closing a gap ``gap`` (m) on a rigid stop at
+        ``a`` (m) from the clamp, at the uniform sample times ``t`` (s) for the voltage
+        samples ``v`` (V, held), quasi-static and small deflection.
+
+        Free, the deflection at a is y(t) = kappa(t) a^2 / 2 (uniform moment). Once it
+        reaches the stop (y = gap, then y increasing) the stop takes the excess: with the
+        mechanical block's relaxation modulus E(t) = EI [p/z + (1 - p/z) exp(-z t)] (the
+        standard linear solid whose compliance is g_m (s + z)/(s + p)), F(t) = (3 / a^3)
+        int E(t - tau) d/dtau max(y(tau) - gap, 0) dtau, i.e. the excess filtered by
+        (3 EI / a^3)(s + p)/(s + z) (scipy lsim). Limits: without relaxation
+        F = 3 M / (2 a) - 3 EI gap / a^3 (instantaneous EI); long after a held voltage
+        F = 3 M / (2 a) - 3 (EI p / z) gap / a^3 (relaxed EI), M = the relaxed moment."""
+        EI = 1.0 / self.mechanical_gain
+        excess = np.clip(self.free_curvature(t, v) * a**2 / 2 - gap, 0.0, None)
+        tf = signal.TransferFunction([3 * EI / a**3, 3 * EI / a**3 * self.pole], [1.0, self.zero])
+        return signal.lsim(tf, excess, np.asarray(t, float), interp=True)[1]
 
     def response(self, t: np.ndarray, v: np.ndarray, mass: float = 0.0, l_e: float = 6e-3,
                  kappa0: float = 0.0) -> Tuple[np.ndarray, np.ndarray]:

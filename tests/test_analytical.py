@@ -57,3 +57,23 @@ def test_arc_curvature_recovers_a_circle():
     k = 150.0
     x, y, _ = an.arc_tip_moment(k * EI, L, EI)
     assert an.arc_curvature(x, y) == pytest.approx(k, rel=1e-12)
+
+
+def test_grip_force_closed_form_has_the_elastic_and_relaxed_limits():
+    """DadrasModel.grip_force (the hereditary integral of the back-relaxation) against its two
+    limits, from closed forms: with the relaxation switched off (zero = pole) it is
+    3 M(t)/(2a) - 3 EI gap / a^3 once in contact, M(t) = Gamma V (1 - exp(-p_e t)), to 1e-6;
+    held for 60 s it is 3 Gamma V/(2a) - 3 (EI p/z) gap / a^3 to 1e-6; before contact 0."""
+    from dataclasses import replace
+    dm = an.DadrasModel()
+    EI, a, gap, V = 1 / dm.mechanical_gain, 5e-3, 0.05e-3, 1.0
+    gamma = dm.k_tf * EI / dm.electrical_pole
+    t = np.linspace(0, 60, 60001)
+    F = dm.grip_force(t, np.full(t.size, V), a, gap)
+    assert F[-1] == pytest.approx(3 * gamma * V / (2 * a) - 3 * EI * dm.pole / dm.zero * gap / a**3, rel=1e-6)
+    elastic = replace(dm, zero=dm.pole)
+    Fe = elastic.grip_force(t[:5001], np.full(5001, V), a, gap)
+    M = gamma * V * (1 - np.exp(-dm.electrical_pole * t[:5001]))
+    ref = np.clip(3 * M / (2 * a) - 3 * EI * gap / a**3, 0, None)
+    assert np.max(np.abs(Fe - ref)) < 1e-6 * ref.max()
+    assert F[0] == 0 and np.all(F >= -1e-12)
