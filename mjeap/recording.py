@@ -280,11 +280,13 @@ def _geom_archetype(rr, model, g: int, length: float, color):
     return None
 
 
-def write_system_recording(path, result, system) -> Path:
+def write_system_recording(path, result, system, extra=None, views=()) -> Path:
     """Write a :class:`mjeap.system.SystemResult` to ``path`` (.rrd): every beam's
     centreline and tip (world frame, m), every other body's geoms (boxes, spheres,
     ellipsoids, capsules, cylinders) moving with their bodies, and per actuator its voltage
-    and tip curvature; the net contact force on every body that touches something."""
+    and tip curvature; the net contact force on every body that touches something.
+    ``extra(rec)`` may log more entities to the open ``rerun.RecordingStream``; ``views``
+    (rerun blueprint views) are placed first in the plots' column for them."""
     import rerun as rr
     import rerun.blueprint as rrb
     path = Path(path)
@@ -302,7 +304,7 @@ def write_system_recording(path, result, system) -> Path:
     left = rrb.Vertical(rrb.Spatial3DView(origin="/world", name="system (m)",
                                           line_grid=rrb.archetypes.LineGrid3D(visible=True)),
                         rrb.TextDocumentView(origin="/meta", name="run parameters"), row_shares=[3, 1])
-    bp = rrb.Blueprint(rrb.Horizontal(left, rrb.Vertical(*groups), column_shares=[3, 2]),
+    bp = rrb.Blueprint(rrb.Horizontal(left, rrb.Vertical(*views, *groups), column_shares=[3, 2]),
                        rrb.BlueprintPanel(state="collapsed"), rrb.SelectionPanel(state="collapsed"),
                        rrb.TimePanel(state="collapsed", timeline="time", play_state="paused"))
     rec = rr.RecordingStream("mjeap", recording_id=f"system-{'-'.join(names)}")
@@ -368,6 +370,8 @@ def write_system_recording(path, result, system) -> Path:
             if n:
                 rec.set_time("time", duration=float(t[-1]))
             rec.log("log", rr.TextLog(result.meta["error"], level="ERROR"))
+        if extra is not None:
+            extra(rec)
     finally:
         rec.flush()
         rec.disconnect()

@@ -15,9 +15,12 @@ Model (host in mm, mg, ms):
   (its linearised tip deflection) and a tendon equality stroke = T_eff x that deflection,
   T_eff = 4000 rad/m (seed 003, from its ref. [48]): the small-motion transmission the paper
   uses to turn the actuator's motion into a stroke angle.
-- Wing: 15 mm long (seed 003's 3.5 cm wingspan less the thorax), 4 mm chord and 0.5 mg.
-  ASSUMED: the chord and mass are not in the sources here; the resonance scales with
-  1/sqrt(wing inertia).
+- Wing: 15 mm long, 5 mm mean chord, 0.51 mg. Not in the seeds; taken from a secondary
+  source, the Harvard Microrobotics Lab's public RoboBee wing models (github.com/avikde/
+  robobee3d, flapopt/Wing2DOF.py: R = 15 mm, m_wing = 0.51 mg; flapopt/wingopt.py: mean
+  chord 5 mm). The length agrees with seed 003's 3.5 cm wingspan (two wings and a ~5 mm
+  thorax). Drawn as a 15 x 5 mm plate; MuJoCo's ellipsoid model sees the inscribed
+  ellipse (pi/4 of the plate's area). The resonance scales with 1/sqrt(wing inertia).
 
 Self-sensing: the estimator of controllers/self_sensing.py (eqs. 7-9), calibrated on the
 free actuator's sine sweep at the same bias (as the paper calibrates on the bench), turns
@@ -40,53 +43,66 @@ from mjeap.frequency import sine_sweep
 from mjeap.system import System, attach
 
 T_EFF = 4000.0                                  # rad/m, seed 003 section 6.1
-SPAN, CHORD, THICKNESS = 15e-3, 4e-3, 20e-6     # m (chord and thickness assumed)
-WING_MASS = 0.5e-6                              # kg (assumed)
-HINGE_OFFSET = 1e-3                             # m, wing root from the stroke axis
+SPAN, CHORD, THICKNESS = 15e-3, 5e-3, 20e-6     # m (length, mean chord: secondary source; thickness drawn)
+WING_MASS = 0.51e-6                             # kg (secondary source, see the module text)
+HINGE_OFFSET = 1e-3                             # m, wing root beyond the stroke axis (drawn)
 AIR_DENSITY, AIR_VISCOSITY = 1.2, 1.8e-5        # kg/m^3, Pa s
 FREQUENCIES = np.arange(30.0, 271.0, 30.0)      # Hz, the paper's 30-270 Hz
 VOLTAGES = (100.0, 200.0)                       # V, bias; the signal swings 0..bias
 CYCLES, LAST = 30, 4                            # cycles per frequency; the last ones are measured
 
 
-def build() -> System:
-    """The actuator and wing as a System (host in mm, mg, ms)."""
-    s, c, t, o = SPAN * 1e3, CHORD * 1e3, THICKNESS * 1e3, HINGE_OFFSET * 1e3
+def wing_inertia() -> float:
+    """The wing's moment of inertia about the stroke axis (kg m^2): a plate of SPAN x CHORD
+    whose root is HINGE_OFFSET from the axis."""
+    return WING_MASS * (SPAN**2 / 12 + (HINGE_OFFSET + SPAN / 2) ** 2 + THICKNESS**2 / 12)
+
+
+def build(bias: float = 200.0, air: bool = True) -> System:
+    """The actuator (drive biased at ``bias``, V) and the wing as a System (host in mm, mg,
+    ms); ``air=False`` leaves the fluid out. The stroke hinge sits 1/T_eff beyond the actuator's tip, so the transmission reads
+    as a lever of that length from the tip; the wing spans on from the hinge."""
     spec = mujoco.MjSpec.from_string(f"""<mujoco>
-  <option gravity="0 0 -9.80665e-3" density="{AIR_DENSITY * 1e-3}" viscosity="{AIR_VISCOSITY}"/>
-  <worldbody>
-    <site name="mount"/>
-    <body name="wing" pos="-5 0 0">
-      <joint name="stroke" type="hinge" axis="0 0 1"/>
-      <geom name="wing" type="box" size="{s / 2} {t / 2} {c / 2}" pos="{-s / 2 - o} 0 0" mass="{WING_MASS * 1e6}"
-            fluidshape="ellipsoid" contype="0" conaffinity="0" rgba="0.75 0.8 1 0.6"/>
-    </body>
-  </worldbody>
+  <option gravity="0 0 -9.80665e-3" density="{AIR_DENSITY * 1e-3 * air}" viscosity="{AIR_VISCOSITY * air}"/>
+  <worldbody><site name="mount"/></worldbody>
 </mujoco>""")
-    act = attach(spec, "pzt-robobee", site="mount", prefix="act", contact=False)
+    act = attach(spec, "pzt-robobee", site="mount", prefix="act", contact=False, drive_params={"bias": bias})
     lay, u = act.twin.layout, act.twin.units
+    s, c, t, o = (v / u.length for v in (SPAN, CHORD, THICKNESS, HINGE_OFFSET))
+    lever = 1 / (T_EFF * u.length)
+    wing = spec.worldbody.add_body(name="wing", pos=[lay.tip_x / u.length + lever, 0, 0])
+    wing.add_joint(name="stroke", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 0, 1])
+    wing.add_geom(name="lever", type=mujoco.mjtGeom.mjGEOM_CAPSULE, fromto=[-lever, 0, 0, o, 0, 0],
+                  size=[0.05, 0, 0], mass=0, contype=0, conaffinity=0, rgba=[0.3, 0.3, 0.3, 1])
+    wing.add_geom(name="wing", type=mujoco.mjtGeom.mjGEOM_BOX, size=[s / 2, t / 2, c / 2], pos=[o + s / 2, 0, 0],
+                  mass=WING_MASS / u.mass, fluid_ellipsoid=1,
+                  contype=0, conaffinity=0, rgba=[0.75, 0.8, 1, 0.6])
     tip = spec.add_tendon(name="tip_deflection")
     for j, x in zip(act.joints, lay.hinge_x):
         tip.wrap_joint(j, (lay.tip_x - x) / u.length)
     spec.add_tendon(name="stroke_angle").wrap_joint("stroke", 1.0)
+    # the lever: the tip moving +y turns the wing the negative way about z
     eq = spec.add_equality(type=mujoco.mjtEq.mjEQ_TENDON, name1="stroke_angle", name2="tip_deflection")
-    eq.data[:5] = [0.0, T_EFF * u.length, 0.0, 0.0, 0.0]
+    eq.data[:5] = [0.0, -T_EFF * u.length, 0.0, 0.0, 0.0]
     return System(spec, [act])
 
 
 def estimator(bias: float):
-    """Eqs. 7-9 calibrated on the free actuator's sweep at ``bias`` (C_fit: the datasheet's
-    2 x the free capacitance, as the paper's bench)."""
+    """Eqs. 7-9 calibrated on the free actuator's sweep at ``bias``, as the paper calibrates
+    on the bench, not on the wing. R_fit, C_fit: the drive's own dielectric resistance and
+    capacitance stand in for Table 2's fixed-actuator measurement (the table's extracted
+    coefficients are unreliable, see the reference notes); beta by eq. 8."""
     free = Scene("pzt-robobee")
-    c = make_drive("piezo-bimorph", free).params["capacitance"]
+    p = make_drive("piezo-bimorph", free, bias=bias).params
     sw = sine_sweep(free, (30.0, 100.0, 300.0, 1000.0, 2000.0), bias / 2, bias / 4, drive_params={"bias": bias})
-    return calibrate(sw, bias, 1e9, 2 * c)
+    return calibrate(sw, bias, p["resistance"], p["capacitance"])
 
 
-def flap(system: System, bias: float, frequency: float, est, rrd=None) -> dict:
+def flap(system: System, bias: float, frequency: float, est, trace: bool = False) -> dict:
     """Sine drive 0..bias at ``frequency`` for CYCLES cycles: stroke amplitudes (deg) over
     the last LAST cycles, simulated and self-sensed, and their steady-state check (the
-    amplitude of the cycles before, relative)."""
+    amplitude of the cycles before, relative). ``trace``: also the rollout and the stroke
+    angle's time series (s, deg), simulated and self-sensed, under 'trace'."""
     q = system.model.joint("stroke").qposadr[0]
     angle = []
 
@@ -94,7 +110,7 @@ def flap(system: System, bias: float, frequency: float, est, rrd=None) -> dict:
         angle.append(sy.data.qpos[q])
 
     r = system.rollout([f"sine:{bias / 2}V@{frequency}Hz,offset={bias / 2}V"], CYCLES / frequency,
-                       sample_interval=1 / (frequency * 100), on_sample=on_sample, rrd=rrd)
+                       sample_interval=1 / (frequency * 100), on_sample=on_sample)
     a = r.actuators["act"]
     angle = np.array(angle)
     v = est.velocity(a.time, a.voltage, a.signals["current (A)"])
@@ -102,9 +118,37 @@ def flap(system: System, bias: float, frequency: float, est, rrd=None) -> dict:
     late = a.time > (CYCLES - LAST) / frequency
     before = (a.time > (CYCLES - 2 * LAST) / frequency) & ~late
     amp = np.degrees(0.5 * np.ptp(angle[late]))
-    return {"frequency_hz": frequency, "stroke_deg": float(amp),
-            "estimated_deg": float(np.degrees(0.5 * np.ptp(T_EFF * y[late]))),
-            "steady": float(abs(np.degrees(0.5 * np.ptp(angle[before])) / amp - 1))}
+    out = {"frequency_hz": frequency, "stroke_deg": float(amp),
+           "estimated_deg": float(np.degrees(0.5 * np.ptp(T_EFF * y[late]))),
+           "steady": float(abs(np.degrees(0.5 * np.ptp(angle[before])) / amp - 1))}
+    if trace:
+        # the estimate is a drift-free position only up to its mean (the integral's start)
+        est_deg = np.degrees(T_EFF * y)
+        est_deg += np.degrees(angle[late]).mean() - est_deg[late].mean()
+        out["trace"] = (r, a.time, np.degrees(angle), est_deg)
+    return out
+
+
+def write_recording(path, system, traces: dict) -> None:
+    """The 150 Hz run at 200 V in 3D (actuator and wing) and the stroke angle at 150 Hz,
+    simulated and self-sensed, at both voltages (the paper's Fig. 7(a)). The amplitude
+    against frequency (Fig. 7(c)) is the JSON's 'sweeps'."""
+    import rerun as rr
+    import rerun.blueprint as rrb
+    from mjeap.recording import write_system_recording
+
+    colours = {"100V": [40, 110, 220], "200V": [220, 60, 60]}
+
+    def extra(rec):
+        for v, (r, t, sim, est) in traces.items():
+            for kind, y, width in (("simulated", sim, 2.0), ("self-sensed", est, 1.0)):
+                ent = f"wing/stroke_150Hz/{v}/{kind}"
+                rec.log(ent, rr.SeriesLines(names=f"{v} {kind}: stroke angle (deg)", colors=[colours[v]],
+                                            widths=[width]), static=True)
+                rec.send_columns(ent, indexes=[rr.TimeColumn("time", duration=t)],
+                                 columns=rr.Scalars.columns(scalars=y))
+    views = (rrb.TimeSeriesView(origin="/wing/stroke_150Hz", name="stroke angle at 150 Hz (deg): simulated, self-sensed"),)
+    write_system_recording(path, traces["200V"][0], system, extra=extra, views=views)
 
 
 def main(argv=None):
@@ -114,12 +158,13 @@ def main(argv=None):
     a = ap.parse_args(argv)
     Path(a.out).parent.mkdir(parents=True, exist_ok=True)
     freqs = FREQUENCIES[1::2] if a.quick else FREQUENCIES
-    system = build()
     out = {"t_eff_rad_per_m": T_EFF, "wing_span_m": SPAN, "wing_chord_m": CHORD, "wing_mass_kg": WING_MASS,
-           "assumed": "wing chord and mass", "sweeps": {}}
-    errors = []
+           "wing_source": "secondary: Harvard Microrobotics Lab public wing models (avikde/robobee3d)", "sweeps": {}}
+    errors, traces = [], {}
     for bias in VOLTAGES:
+        system = build(bias)
         est = estimator(bias)
+        traces[f"{bias:g}V"] = flap(system, bias, 150.0, est, trace=True)["trace"]
         rows = [flap(system, bias, f, est) for f in freqs]
         out["sweeps"][f"{bias:g}V"] = rows
         peak = max(rows, key=lambda r: r["stroke_deg"])
@@ -129,7 +174,7 @@ def main(argv=None):
     out["resonance_hz"] = out[f"resonance_hz_{VOLTAGES[0]:g}V"]
     out["max_estimate_error"] = float(max(errors))
     out["max_unsteadiness"] = float(max(r["steady"] for s in out["sweeps"].values() for r in s))
-    flap(system, 200.0, 150.0, estimator(200.0), rrd=a.out)
+    write_recording(a.out, system, traces)  # the 200 V system
     out["recording"] = a.out
     print(json.dumps(out, indent=1, default=float))
 
