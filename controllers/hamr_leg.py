@@ -53,6 +53,8 @@ class Transmission:
 
 
 SWING = Transmission("swing", 13.0, 100.0, 0.0)
+#: the lift, 90 degrees ahead of the swing: the foot traces the ellipse of seed 003 (ref. [50])
+LIFT = Transmission("lift", 12.0, 80.0, np.pi / 2)
 
 
 def free_actuator():
@@ -89,6 +91,37 @@ def pid_gains(damping_ratio: float, resonance: float, frequency: float, pole: fl
     g = pole**2                       # z^2 - z + g = (z - pole)^2 with pole = 1/2
     k = g / (1 - a)
     return a * k, (1 - a) * k, 0.0
+
+
+def phase_loop_characteristic(kp: float, ki: float, damping_ratio: float, resonance: float,
+                              frequency: float) -> np.ndarray:
+    """Closed-loop characteristic polynomial (in z, per drive cycle) of the phase loop on a
+    second-order transmission driven at ``frequency`` off its ``resonance``: after a drive
+    phase step Delta the response phasor relaxes as c^k, c = exp((-zeta w_n + i (w_n - w)) / f),
+    so the foot phase follows 1 - Re(c^k) (small Delta): G(z) = 1 - (z - 1)(z - Re c) /
+    ((z - c)(z - c*)); measured one cycle late, under the velocity-form PI
+    C(z) = ((kp + ki) z - kp) / (z - 1). At resonance c is real and G = (1 - a) / (z - a)."""
+    c = np.exp((-damping_ratio * 2 * np.pi * resonance + 1j * 2 * np.pi * (resonance - frequency)) / frequency)
+    den = np.real(np.poly([c, np.conj(c)]))
+    num = np.polysub(den, np.polymul([1.0, -1.0], [1.0, -c.real]))
+    return np.polyadd(np.polymul([1.0, -1.0, 0.0], den), np.polymul([kp + ki, -kp], num))
+
+
+def phase_loop_gains(damping_ratio: float, resonance: float, frequency: float):
+    """(kp, ki, kd) that minimise the closed loop's spectral radius
+    (:func:`phase_loop_characteristic`, scipy Nelder-Mead from :func:`pid_gains`); the
+    latter where it is already optimal (at resonance, where its zero cancels the plant's
+    pole and the others sit at 1/2). Off resonance the transient beats at |f_n - f| and the
+    at-resonance gains can be unstable (the lift at 80 Hz driven at 100 Hz)."""
+    def radius(g):
+        return float(np.max(np.abs(np.roots(phase_loop_characteristic(g[0], g[1], damping_ratio, resonance,
+                                                                      frequency)))))
+
+    g0 = pid_gains(damping_ratio, resonance, frequency)
+    res = optimize.minimize(radius, g0[:2], method="Nelder-Mead", options={"xatol": 1e-6, "fatol": 1e-9})
+    if radius(g0[:2]) <= res.fun + 1e-6:
+        return g0
+    return float(res.x[0]), float(res.x[1]), 0.0
 
 
 class LegPhaseController:
@@ -173,6 +206,17 @@ class LegRun:
         return None if n >= e.size else n
 
 
+def free_estimator(bias: float) -> SelfSensingEstimator:
+    """Eqs. 7-9 calibrated once on the free (unloaded) actuator's sine sweep at ``bias`` (V),
+    as the paper calibrates on the bench: the drive's own capacitance stands in for a user's
+    fixed-actuator measurement, beta by eq. 8. The leg does not change it."""
+    free = Scene(free_actuator(), gravity=False)
+    c_fit = make_drive("piezo-bimorph", free, bias=bias).params["capacitance"]
+    sweep = sine_sweep(free, (100.0, 1000.0, 1500.0, 1750.0, 2000.0), bias / 2, bias / 4,
+                       drive_params={"bias": bias})
+    return calibrate(sweep, bias, 1e9, c_fit)
+
+
 def run_leg(transmission: Transmission = SWING, cycles: int = 40, open_loop_cycles: int = 10,
             bias: float = 100.0, amplitude: float = 20.0, frequency: float = 100.0,
             estimator: Optional[SelfSensingEstimator] = None, gains=None, rrd=None) -> LegRun:
@@ -180,13 +224,7 @@ def run_leg(transmission: Transmission = SWING, cycles: int = 40, open_loop_cycl
     The estimator is calibrated on the free actuator unless given (as in the paper, it is
     not changed for the load); the gains follow from the scene unless given."""
     act = free_actuator()
-    if estimator is None:
-        free = Scene(act, gravity=False)
-        # the drive's own capacitance stands in for a user's fixed-actuator measurement
-        c_fit = make_drive("piezo-bimorph", free, bias=bias).params["capacitance"]
-        sweep = sine_sweep(free, (100.0, 1000.0, 1500.0, 1750.0, 2000.0), bias / 2, bias / 4,
-                           drive_params={"bias": bias})
-        estimator = calibrate(sweep, bias, 1e9, c_fit)
+    estimator = estimator or free_estimator(bias)
     sc = leg_scene(transmission, act)
     if gains is None:
         gains = pid_gains(sc.choice.damping_ratio, sc.choice.first_frequency, frequency)

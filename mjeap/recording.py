@@ -276,7 +276,8 @@ def _geom_archetype(rr, model, g: int, length: float, color):
         return rr.Capsules3D(lengths=[2 * size[1]], radii=[size[0]], translations=[start], quaternions=[rot],
                              colors=[color])
     if t == T.mjGEOM_CYLINDER:
-        return rr.Cylinders3D(lengths=[2 * size[1]], radii=[size[0]], centers=[pos], rotations=[rot], colors=[color])
+        return rr.Cylinders3D(lengths=[2 * size[1]], radii=[size[0]], centers=[pos], quaternions=[rot], colors=[color],
+                              fill_mode="solid")
     return None
 
 

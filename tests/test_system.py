@@ -182,3 +182,22 @@ def test_si_host_with_micro_parts_is_refused_with_a_unit_system_that_works():
 def test_host_gravity_in_other_units_is_refused():
     with pytest.raises(ParameterError, match="gravity.*-0.00980665"):
         attach(host('<site name="mount"/>', gravity="0 0 -9.81"), "pedot-micro", site="mount", prefix="a")
+
+
+def test_a_controller_drives_the_system_as_the_waveform_it_returns():
+    """A controller returning the square wave's value before every step gives the same run
+    as the waveform (to round-off); one returning a voltage outside the drive's safe range
+    stops the run with the actuator, the voltage and the range named."""
+    from mjeap.waveforms import parse_waveform
+    spec = host('<site name="mount"/>')
+    a = attach(spec, "pedot-micro", site="mount", prefix="act", contact=False)
+    s = System(spec, [a])
+    w = parse_waveform("square:1V@5Hz")
+    ref = s.rollout(["square:1V@5Hz"], 0.2).actuators["act"]
+    got = s.rollout(None, 0.2, controller=lambda t, sy: [float(w(np.array([t]))[0])]).actuators["act"]
+    np.testing.assert_allclose(got.tip_curvature, ref.tip_curvature, rtol=0, atol=1e-9 * np.abs(ref.tip_curvature).max())
+    np.testing.assert_allclose(got.voltage, ref.voltage, atol=1e-12)
+    with pytest.raises(ParameterError, match="controller voltage of 'act'.*safe range"):
+        s.rollout(None, 0.2, controller=lambda t, sy: [5.0])
+    with pytest.raises(ParameterError, match="voltages"):
+        s.rollout(["step:1V"], 0.2, controller=lambda t, sy: [1.0])

@@ -233,7 +233,7 @@ class Drive:
         view of its part, so that the replay adds no moment or stiffness to a beam the
         native model already drives (a system's, :mod:`mjeap.system`)."""
         own = self.part
-        self.part = _ReadOnlyPart(own)
+        self.part = ReadOnlyPart(own)
         try:
             self.seek(k)
             return self.signals()
@@ -257,7 +257,7 @@ class Drive:
         return f"{self.name} ({self.model_used})" if self.model_used else self.name
 
 
-class _ReadOnlyPart:
+class ReadOnlyPart:
     """A beam part seen by a replayed drive: reads pass through, the drive's writes (its
     moments, its stiffness scale) are kept here and never reach the model."""
 
