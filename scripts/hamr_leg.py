@@ -2,7 +2,7 @@
 through its swing and lift transmissions; resonances from sine sweeps, then the foot
 ellipse at 100 Hz open loop and with both phase loops closed on the self-sensed currents.
 
-    python scripts/hamr_leg.py [--out out/hamr_leg.rrd] [--quick]
+    python scripts/hamr_leg.py [--out out/hamr_leg.rrd] [--cycles 40] [--open-loop-cycles 10]
 
 Prints JSON with swing_resonance_hz, lift_resonance_hz, cycles_to_5deg_swing and
 cycles_to_5deg_lift (closed-loop cycles until the true foot phase error stays within 5
