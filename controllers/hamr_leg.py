@@ -30,11 +30,10 @@ from scipy import optimize
 from mjeap import Scene, rollout
 from mjeap.catalog import get_actuator
 from mjeap.discretize import Payload
-from mjeap.drives import make_drive
 from mjeap.errors import ParameterError, check_positive
-from mjeap.frequency import phasor, sine_sweep
+from mjeap.frequency import phasor
 
-from .self_sensing import SelfSensingEstimator, calibrate
+from .self_sensing import SelfSensingEstimator, calibrate_on_free_actuator
 
 ACTUATOR = "pzt-hamr-small"
 MEASURED_RESONANCE = 1750.0     # Hz, Table 1, Type II
@@ -200,21 +199,35 @@ class LegRun:
 
     def cycles_to_within(self, tol_deg: float = 5.0, which: str = "true") -> Optional[int]:
         """Closed-loop cycles until the phase error stays within ``tol_deg``."""
-        e = np.abs(self.true_error_deg if which == "true" else self.sensed_error_deg)[self.open_loop_cycles:]
-        bad = np.nonzero(e > tol_deg)[0]
-        n = 0 if bad.size == 0 else int(bad[-1]) + 1
-        return None if n >= e.size else n
+        return cycles_to_within(self.true_error_deg if which == "true" else self.sensed_error_deg,
+                                self.open_loop_cycles, tol_deg)
 
 
 def free_estimator(bias: float) -> SelfSensingEstimator:
-    """Eqs. 7-9 calibrated once on the free (unloaded) actuator's sine sweep at ``bias`` (V),
-    as the paper calibrates on the bench: the drive's own capacitance stands in for a user's
-    fixed-actuator measurement, beta by eq. 8. The leg does not change it."""
-    free = Scene(free_actuator(), gravity=False)
-    c_fit = make_drive("piezo-bimorph", free, bias=bias).params["capacitance"]
-    sweep = sine_sweep(free, (100.0, 1000.0, 1500.0, 1750.0, 2000.0), bias / 2, bias / 4,
-                       drive_params={"bias": bias})
-    return calibrate(sweep, bias, 1e9, c_fit)
+    """Eqs. 7-9 calibrated on the free HAMR actuator (:func:`calibrate_on_free_actuator`)
+    around its 1750 Hz resonance; the leg does not change it."""
+    return calibrate_on_free_actuator(free_actuator(), bias, (100.0, 1000.0, 1500.0, 1750.0, 2000.0), gravity=False)
+
+
+def cycles_to_within(errors_deg, open_loop_cycles: int, tol_deg: float = 5.0) -> Optional[int]:
+    """Closed-loop cycles (after ``open_loop_cycles``) until the per-cycle phase error
+    ``errors_deg`` stays within ``tol_deg``; None if it never does."""
+    e = np.abs(np.asarray(errors_deg))[open_loop_cycles:]
+    bad = np.nonzero(e > tol_deg)[0]
+    n = 0 if bad.size == 0 else int(bad[-1]) + 1
+    return None if n >= e.size else n
+
+
+def phase_errors_per_cycle(time, position, frequency: float, desired_phase: float, cycles: int) -> np.ndarray:
+    """Per drive cycle, the position's phase error (deg) to the desired sin(omega t +
+    ``desired_phase``): a lock-in (:func:`mjeap.frequency.phasor`) over each cycle's samples."""
+    time, position = np.asarray(time), np.asarray(position)
+    out = []
+    for n in range(cycles):
+        sel = (time >= n / frequency) & (time < (n + 1) / frequency)
+        z = phasor(time[sel], position[sel], frequency)
+        out.append(np.angle(np.exp(1j * (desired_phase - np.pi / 2 - np.angle(z)))))
+    return np.degrees(out)
 
 
 def run_leg(transmission: Transmission = SWING, cycles: int = 40, open_loop_cycles: int = 10,
@@ -232,12 +245,9 @@ def run_leg(transmission: Transmission = SWING, cycles: int = 40, open_loop_cycl
     r = rollout(sc, None, cycles / frequency, drive_params={"bias": bias}, controller=ctrl,
                 sample_interval=sc.timestep, progress=False)
     # true foot phase per cycle, from the simulated tip deflection (lock-in of each cycle)
-    true = []
-    for n in range(len(ctrl.errors)):
-        sel = (r.time >= n / frequency) & (r.time < (n + 1) / frequency)
-        x = phasor(r.time[sel], r.tip_position[sel, 1], frequency)
-        true.append(np.angle(np.exp(1j * (transmission.desired_phase - np.pi / 2 - np.angle(x)))))
-    run = LegRun(transmission, r, np.degrees(ctrl.errors), np.degrees(true), open_loop_cycles,
+    true = phase_errors_per_cycle(r.time, r.tip_position[:, 1], frequency, transmission.desired_phase,
+                                  len(ctrl.errors))
+    run = LegRun(transmission, r, np.degrees(ctrl.errors), true, open_loop_cycles,
                  {"gains_kp_ki_kd": list(gains), "leg_mass_reflected_kg": sc.payload.mass,
                    "foot_mass_kg": sc.payload.mass / transmission.ratio**2,
                    "resonance_hz": sc.choice.first_frequency, "estimator": estimator.fit,

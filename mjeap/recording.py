@@ -139,6 +139,19 @@ def _meta_markdown(meta: dict) -> str:
     return "\n".join(lines)
 
 
+def _log_outcome(rec, meta: dict, t, extra) -> None:
+    """The run's warnings and error (at its last sample's time) as text logs, then the
+    caller's ``extra(rec)`` entities."""
+    import rerun as rr
+    for level, texts in (("WARN", meta.get("warnings", [])), ("ERROR", [meta["error"]] if "error" in meta else [])):
+        for text in texts:
+            if len(t):
+                rec.set_time("time", duration=float(t[-1]))
+            rec.log("log", rr.TextLog(text, level=level))
+    if extra is not None:
+        extra(rec)
+
+
 def write_recording(path, result, scene, extra=None, views=(), deformation: float = None) -> Path:
     """Write ``result`` of a rollout of ``scene`` to ``path`` (.rrd); the file is flushed
     and closed before returning, also for a failed (partial) run. ``extra(rec)`` may log
@@ -211,16 +224,7 @@ def write_recording(path, result, scene, extra=None, views=(), deformation: floa
                 pp[:, 1:] *= scale
                 rec.send_columns("beam/payload", indexes=[tf], columns=rr.Points3D.columns(positions=pp @ R.T))
                 rec.log("beam/payload", rr.Points3D.from_fields(radii=[pay_r], colors=[[190, 50, 50]]), static=True)
-        for w in result.meta.get("warnings", []):
-            if n:
-                rec.set_time("time", duration=float(t[-1]))
-            rec.log("log", rr.TextLog(w, level="WARN"))
-        if "error" in result.meta:
-            if n:
-                rec.set_time("time", duration=float(t[-1]))
-            rec.log("log", rr.TextLog(result.meta["error"], level="ERROR"))
-        if extra is not None:
-            extra(rec)
+        _log_outcome(rec, result.meta, t, extra)
     finally:
         rec.flush()
         rec.disconnect()
@@ -367,12 +371,7 @@ def write_system_recording(path, result, system, extra=None, views=()) -> Path:
             rec.log(ent, rr.SeriesLines(names=f"{result.body_names[b]}: |contact force| (N)"), static=True)
             rec.send_columns(ent, indexes=[rr.TimeColumn("time", duration=t)],
                              columns=rr.Scalars.columns(scalars=np.linalg.norm(result.contact_force[:, b], axis=1)))
-        if "error" in result.meta:
-            if n:
-                rec.set_time("time", duration=float(t[-1]))
-            rec.log("log", rr.TextLog(result.meta["error"], level="ERROR"))
-        if extra is not None:
-            extra(rec)
+        _log_outcome(rec, result.meta, t, extra)
     finally:
         rec.flush()
         rec.disconnect()

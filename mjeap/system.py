@@ -197,6 +197,27 @@ def attach(spec: mujoco.MjSpec, actuator, *, prefix: str, site: Optional[str] = 
     return AttachedActuator(prefix + "/", twin, drv, nat, contact)
 
 
+def add_transmission(spec: mujoco.MjSpec, actuator: AttachedActuator, joint: str, ratio: float) -> None:
+    """Couple the host's hinge ``joint`` to an attached ``actuator``'s tip: joint angle (rad)
+    = ``ratio`` (rad/m, signed) x the tip's deflection linearised in the hinge angles (m),
+    the small-motion transmission seed 003 states (RoboBee T_eff, HAMR T / leg length). A
+    fixed tendon '<prefix>tip_deflection' sums the actuator's hinges with coefficients
+    x_tip - x_j, a tendon '<prefix>transmission' reads the joint, and a tendon equality
+    holds one at ``ratio`` times the other."""
+    if not np.isfinite(ratio) or ratio == 0:
+        raise ParameterError("ratio", ratio, "a finite, non-zero transmission ratio in rad/m")
+    if spec.joint(joint) is None:
+        raise UnknownNameError("joint", joint, [j.name for j in spec.joints])
+    lay, u = actuator.twin.layout, actuator.twin.units
+    tip = spec.add_tendon(name=actuator.name("tip_deflection"))
+    for j, x in zip(actuator.joints, lay.hinge_x):
+        tip.wrap_joint(j, (lay.tip_x - x) / u.length)
+    spec.add_tendon(name=actuator.name("transmission")).wrap_joint(joint, 1.0)
+    eq = spec.add_equality(type=mujoco.mjtEq.mjEQ_TENDON, name1=actuator.name("transmission"),
+                           name2=actuator.name("tip_deflection"))
+    eq.data[:5] = [0.0, ratio * u.length, 0.0, 0.0, 0.0]
+
+
 @dataclass
 class SystemResult:
     """A system rollout, SI: one :class:`~mjeap.rollout.RolloutResult` per actuator (by

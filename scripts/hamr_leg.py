@@ -14,10 +14,10 @@ Model (host in mm, mg, ms; gravity along -z):
   hinge (axis z) carries a swing stage; on it the lift hinge (axis x, turning with the
   stage) carries the leg and the lift lever. Swing moves the foot fore-aft (x), lift up and
   down (z): the foot's position is the 3D kinematics of these joints.
-- Each transmission: a fixed tendon over the actuator's hinges with coefficients x_tip - x_j
-  (its linearised tip deflection d) and a tendon equality that turns the leg joint by
-  T d / LEG_LENGTH, so that the foot moves T x the tip for small motion (T_swing = 13,
-  T_lift = 12, seed 003 from its ref. [51]).
+- Each transmission (mjeap.system.add_transmission): a tendon equality that turns the leg
+  joint by T d / LEG_LENGTH, d the actuator's tip deflection linearised in its hinge angles,
+  so that the foot moves T x the tip for small motion (T_swing = 13, T_lift = 12, seed 003
+  from its ref. [51]).
 - Inertia: for each degree of freedom, the tip mass that puts the loaded actuator's first
   mode at the paper's transmission resonance (100 Hz swing, 80 Hz lift: the point-mass leg
   of controllers/hamr_leg.py, scipy brentq on the scene's modes) is reflected to the joint,
@@ -46,10 +46,11 @@ import mujoco
 import numpy as np
 from scipy import optimize
 
-from controllers.hamr_leg import LIFT, SWING, LegPhaseController, free_estimator, leg_scene, phase_loop_gains
+from controllers.hamr_leg import (LIFT, SWING, LegPhaseController, cycles_to_within, free_estimator, leg_scene,
+                                  phase_errors_per_cycle, phase_loop_gains)
 from mjeap import Scene
 from mjeap.frequency import phasor
-from mjeap.system import System, attach
+from mjeap.system import System, add_transmission, attach
 
 ACTUATOR = "pzt-hamr-small"
 LEG_LENGTH = 10e-3            # m, assumed (see the module text)
@@ -124,14 +125,7 @@ def build(d: dict, bias: float = BIAS) -> System:
     # transmissions: joint angle = sign x T d / LEG_LENGTH, the foot moving +T d along x / z
     sign = {"swing": -1.0, "lift": 1.0}     # about z a +y leg moves its foot -x; about x, +z
     for name, tr in DOFS.items():
-        a = acts[name]
-        lay = a.twin.layout
-        t = spec.add_tendon(name=f"{name}_tip_deflection")
-        for j, x in zip(a.joints, lay.hinge_x):
-            t.wrap_joint(j, (lay.tip_x - x) / u.length)
-        spec.add_tendon(name=f"{name}_angle").wrap_joint(name, 1.0)
-        eq = spec.add_equality(type=mujoco.mjtEq.mjEQ_TENDON, name1=f"{name}_angle", name2=f"{name}_tip_deflection")
-        eq.data[:5] = [0.0, sign[name] * tr.ratio / ell, 0.0, 0.0, 0.0]
+        add_transmission(spec, acts[name], name, sign[name] * tr.ratio / LEG_LENGTH)
     return System(spec, [acts["swing"], acts["lift"]])
 
 
@@ -152,8 +146,7 @@ def sweep(system: System, name: str, frequencies=SWEEP) -> dict:
                            on_sample=lambda s: pos.append(foot(s)[FOOT_COORD[name]]))
         t = r.time[:len(pos)]
         late = t >= (SWEEP_CYCLES - SWEEP_LAST) / f - 1e-12
-        x = np.asarray(pos)[late] - np.mean(np.asarray(pos)[late])
-        z = phasor(t[late], x, f) / AMPLITUDE
+        z = phasor(t[late], np.asarray(pos)[late], f) / AMPLITUDE     # its offset fitted alongside
         # the drive is sin(omega t): its phasor is -i; the response relative to it
         z = z / -1j
         mag.append(abs(z))
@@ -226,14 +219,9 @@ def run_closed_loop(system: System, cycles: int = 40, open_loop_cycles: int = 10
     ts, feet = res.time[:len(feet)], np.array(feet)
     out = {"result": res, "time": ts, "foot": feet, "errors": {}, "open_loop_cycles": open_loop_cycles}
     for name, tr in DOFS.items():
-        x = feet[:, FOOT_COORD[name]]
-        true = []
-        for c in range(len(ctrl.ctrls[name].errors)):
-            sel = (ts >= c / FREQUENCY - 1e-12) & (ts < (c + 1) / FREQUENCY - 1e-12)
-            z = phasor(ts[sel], x[sel] - x[sel].mean(), FREQUENCY)
-            true.append(np.degrees(np.angle(np.exp(1j * (tr.desired_phase - np.pi / 2 - np.angle(z))))))
-        out["errors"][name] = {"sensed_deg": np.degrees(ctrl.ctrls[name].errors), "true_deg": np.array(true),
-                               "gains": list(ctrl.ctrls[name].gains)}
+        c = ctrl.ctrls[name]
+        true = phase_errors_per_cycle(ts, feet[:, FOOT_COORD[name]], FREQUENCY, tr.desired_phase, len(c.errors))
+        out["errors"][name] = {"sensed_deg": np.degrees(c.errors), "true_deg": true, "gains": list(c.gains)}
     if rrd is not None:
         write_recording(rrd, system, out)
     return out
@@ -285,14 +273,6 @@ def write_recording(path, system: System, run: dict) -> None:
                                 f"{n_open} cycles"),
              rrb.TimeSeriesView(origin="/leg/foot", name="foot position about its mean (m)"))
     write_system_recording(path, run["result"], system, extra=extra, views=views)
-
-
-def cycles_to_within(errors, open_loop_cycles: int, tol: float = 5.0):
-    """Closed-loop cycles until |error| stays within ``tol`` degrees (None: never)."""
-    e = np.abs(np.asarray(errors))[open_loop_cycles:]
-    bad = np.nonzero(e > tol)[0]
-    k = 0 if bad.size == 0 else int(bad[-1]) + 1
-    return None if k >= e.size else k
 
 
 def main(argv=None):

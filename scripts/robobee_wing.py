@@ -11,10 +11,10 @@ Model (host in mm, mg, ms):
 - the actuator attached without contact (its own damping and timestep);
 - the wing: a rigid plate on a stroke hinge, MuJoCo's ellipsoid fluid model in air
   (1.2 kg/m^3, 1.8e-5 Pa s);
-- the transmission: a fixed tendon with coefficients x_tip - x_j over the actuator's hinges
-  (its linearised tip deflection) and a tendon equality stroke = T_eff x that deflection,
-  T_eff = 4000 rad/m (seed 003, from its ref. [48]): the small-motion transmission the paper
-  uses to turn the actuator's motion into a stroke angle.
+- the transmission (mjeap.system.add_transmission): a tendon equality stroke = T_eff x the
+  actuator's tip deflection linearised in its hinge angles, T_eff = 4000 rad/m (seed 003,
+  from its ref. [48]): the small-motion transmission the paper uses to turn the actuator's
+  motion into a stroke angle.
 - Wing: 15 mm long, 5 mm mean chord, 0.51 mg. Not in the seeds; taken from a secondary
   source, the Harvard Microrobotics Lab's public RoboBee wing models (github.com/avikde/
   robobee3d, flapopt/Wing2DOF.py: R = 15 mm, m_wing = 0.51 mg; flapopt/wingopt.py: mean
@@ -36,11 +36,8 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from controllers.self_sensing import calibrate
-from mjeap import Scene
-from mjeap.drives import make_drive
-from mjeap.frequency import sine_sweep
-from mjeap.system import System, attach
+from controllers.self_sensing import calibrate_on_free_actuator
+from mjeap.system import System, add_transmission, attach
 
 T_EFF = 4000.0                                  # rad/m, seed 003 section 6.1
 SPAN, CHORD, THICKNESS = 15e-3, 5e-3, 20e-6     # m (length, mean chord: secondary source; thickness drawn)
@@ -77,25 +74,15 @@ def build(bias: float = 200.0, air: bool = True) -> System:
     wing.add_geom(name="wing", type=mujoco.mjtGeom.mjGEOM_BOX, size=[s / 2, t / 2, c / 2], pos=[o + s / 2, 0, 0],
                   mass=WING_MASS / u.mass, fluid_ellipsoid=1,
                   contype=0, conaffinity=0, rgba=[0.75, 0.8, 1, 0.6])
-    tip = spec.add_tendon(name="tip_deflection")
-    for j, x in zip(act.joints, lay.hinge_x):
-        tip.wrap_joint(j, (lay.tip_x - x) / u.length)
-    spec.add_tendon(name="stroke_angle").wrap_joint("stroke", 1.0)
     # the lever: the tip moving +y turns the wing the negative way about z
-    eq = spec.add_equality(type=mujoco.mjtEq.mjEQ_TENDON, name1="stroke_angle", name2="tip_deflection")
-    eq.data[:5] = [0.0, -T_EFF * u.length, 0.0, 0.0, 0.0]
+    add_transmission(spec, act, "stroke", -T_EFF)
     return System(spec, [act])
 
 
 def estimator(bias: float):
     """Eqs. 7-9 calibrated on the free actuator's sweep at ``bias``, as the paper calibrates
-    on the bench, not on the wing. R_fit, C_fit: the drive's own dielectric resistance and
-    capacitance stand in for Table 2's fixed-actuator measurement (the table's extracted
-    coefficients are unreliable, see the reference notes); beta by eq. 8."""
-    free = Scene("pzt-robobee")
-    p = make_drive("piezo-bimorph", free, bias=bias).params
-    sw = sine_sweep(free, (30.0, 100.0, 300.0, 1000.0, 2000.0), bias / 2, bias / 4, drive_params={"bias": bias})
-    return calibrate(sw, bias, p["resistance"], p["capacitance"])
+    on the bench, not on the wing (controllers.self_sensing.calibrate_on_free_actuator)."""
+    return calibrate_on_free_actuator("pzt-robobee", bias, (30.0, 100.0, 300.0, 1000.0, 2000.0))
 
 
 def flap(system: System, bias: float, frequency: float, est, trace: bool = False) -> dict:

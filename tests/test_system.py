@@ -201,3 +201,16 @@ def test_a_controller_drives_the_system_as_the_waveform_it_returns():
         s.rollout(None, 0.2, controller=lambda t, sy: [5.0])
     with pytest.raises(ParameterError, match="voltages"):
         s.rollout(["step:1V"], 0.2, controller=lambda t, sy: [1.0])
+
+
+def test_transmission_inputs_are_named():
+    """add_transmission refuses a zero or non-finite ratio and an unknown joint, naming them."""
+    from mjeap.system import add_transmission
+    spec = host('<site name="mount"/><body name="arm"><joint name="stroke" type="hinge"/>'
+                '<geom type="sphere" size="1" contype="0" conaffinity="0"/></body>')
+    a = attach(spec, "pzt-robobee", site="mount", prefix="act", contact=False)
+    for bad in (0.0, float("nan")):
+        with pytest.raises(ParameterError, match="ratio"):
+            add_transmission(spec, a, "stroke", bad)
+    with pytest.raises(UnknownNameError, match="nope"):
+        add_transmission(spec, a, "nope", 4000.0)
