@@ -30,11 +30,10 @@ from scipy import optimize
 from mjeap import Scene, rollout
 from mjeap.catalog import get_actuator
 from mjeap.discretize import Payload
-from mjeap.drives import make_drive
 from mjeap.errors import ParameterError, check_positive
-from mjeap.frequency import phasor, sine_sweep
+from mjeap.frequency import phasor
 
-from .self_sensing import SelfSensingEstimator, calibrate
+from .self_sensing import SelfSensingEstimator, calibrate_on_free_actuator
 
 ACTUATOR = "pzt-hamr-small"
 MEASURED_RESONANCE = 1750.0     # Hz, Table 1, Type II
@@ -53,6 +52,8 @@ class Transmission:
 
 
 SWING = Transmission("swing", 13.0, 100.0, 0.0)
+#: the lift, 90 degrees ahead of the swing: the foot traces the ellipse of seed 003 (ref. [50])
+LIFT = Transmission("lift", 12.0, 80.0, np.pi / 2)
 
 
 def free_actuator():
@@ -89,6 +90,37 @@ def pid_gains(damping_ratio: float, resonance: float, frequency: float, pole: fl
     g = pole**2                       # z^2 - z + g = (z - pole)^2 with pole = 1/2
     k = g / (1 - a)
     return a * k, (1 - a) * k, 0.0
+
+
+def phase_loop_characteristic(kp: float, ki: float, damping_ratio: float, resonance: float,
+                              frequency: float) -> np.ndarray:
+    """Closed-loop characteristic polynomial (in z, per drive cycle) of the phase loop on a
+    second-order transmission driven at ``frequency`` off its ``resonance``: after a drive
+    phase step Delta the response phasor relaxes as c^k, c = exp((-zeta w_n + i (w_n - w)) / f),
+    so the foot phase follows 1 - Re(c^k) (small Delta): G(z) = 1 - (z - 1)(z - Re c) /
+    ((z - c)(z - c*)); measured one cycle late, under the velocity-form PI
+    C(z) = ((kp + ki) z - kp) / (z - 1). At resonance c is real and G = (1 - a) / (z - a)."""
+    c = np.exp((-damping_ratio * 2 * np.pi * resonance + 1j * 2 * np.pi * (resonance - frequency)) / frequency)
+    den = np.real(np.poly([c, np.conj(c)]))
+    num = np.polysub(den, np.polymul([1.0, -1.0], [1.0, -c.real]))
+    return np.polyadd(np.polymul([1.0, -1.0, 0.0], den), np.polymul([kp + ki, -kp], num))
+
+
+def phase_loop_gains(damping_ratio: float, resonance: float, frequency: float):
+    """(kp, ki, kd) that minimise the closed loop's spectral radius
+    (:func:`phase_loop_characteristic`, scipy Nelder-Mead from :func:`pid_gains`); the
+    latter where it is already optimal (at resonance, where its zero cancels the plant's
+    pole and the others sit at 1/2). Off resonance the transient beats at |f_n - f| and the
+    at-resonance gains can be unstable (the lift at 80 Hz driven at 100 Hz)."""
+    def radius(g):
+        return float(np.max(np.abs(np.roots(phase_loop_characteristic(g[0], g[1], damping_ratio, resonance,
+                                                                      frequency)))))
+
+    g0 = pid_gains(damping_ratio, resonance, frequency)
+    res = optimize.minimize(radius, g0[:2], method="Nelder-Mead", options={"xatol": 1e-6, "fatol": 1e-9})
+    if radius(g0[:2]) <= res.fun + 1e-6:
+        return g0
+    return float(res.x[0]), float(res.x[1]), 0.0
 
 
 class LegPhaseController:
@@ -167,10 +199,35 @@ class LegRun:
 
     def cycles_to_within(self, tol_deg: float = 5.0, which: str = "true") -> Optional[int]:
         """Closed-loop cycles until the phase error stays within ``tol_deg``."""
-        e = np.abs(self.true_error_deg if which == "true" else self.sensed_error_deg)[self.open_loop_cycles:]
-        bad = np.nonzero(e > tol_deg)[0]
-        n = 0 if bad.size == 0 else int(bad[-1]) + 1
-        return None if n >= e.size else n
+        return cycles_to_within(self.true_error_deg if which == "true" else self.sensed_error_deg,
+                                self.open_loop_cycles, tol_deg)
+
+
+def free_estimator(bias: float) -> SelfSensingEstimator:
+    """Eqs. 7-9 calibrated on the free HAMR actuator (:func:`calibrate_on_free_actuator`)
+    around its 1750 Hz resonance; the leg does not change it."""
+    return calibrate_on_free_actuator(free_actuator(), bias, (100.0, 1000.0, 1500.0, 1750.0, 2000.0), gravity=False)
+
+
+def cycles_to_within(errors_deg, open_loop_cycles: int, tol_deg: float = 5.0) -> Optional[int]:
+    """Closed-loop cycles (after ``open_loop_cycles``) until the per-cycle phase error
+    ``errors_deg`` stays within ``tol_deg``; None if it never does."""
+    e = np.abs(np.asarray(errors_deg))[open_loop_cycles:]
+    bad = np.nonzero(e > tol_deg)[0]
+    n = 0 if bad.size == 0 else int(bad[-1]) + 1
+    return None if n >= e.size else n
+
+
+def phase_errors_per_cycle(time, position, frequency: float, desired_phase: float, cycles: int) -> np.ndarray:
+    """Per drive cycle, the position's phase error (deg) to the desired sin(omega t +
+    ``desired_phase``): a lock-in (:func:`mjeap.frequency.phasor`) over each cycle's samples."""
+    time, position = np.asarray(time), np.asarray(position)
+    out = []
+    for n in range(cycles):
+        sel = (time >= n / frequency) & (time < (n + 1) / frequency)
+        z = phasor(time[sel], position[sel], frequency)
+        out.append(np.angle(np.exp(1j * (desired_phase - np.pi / 2 - np.angle(z)))))
+    return np.degrees(out)
 
 
 def run_leg(transmission: Transmission = SWING, cycles: int = 40, open_loop_cycles: int = 10,
@@ -180,13 +237,7 @@ def run_leg(transmission: Transmission = SWING, cycles: int = 40, open_loop_cycl
     The estimator is calibrated on the free actuator unless given (as in the paper, it is
     not changed for the load); the gains follow from the scene unless given."""
     act = free_actuator()
-    if estimator is None:
-        free = Scene(act, gravity=False)
-        # the drive's own capacitance stands in for a user's fixed-actuator measurement
-        c_fit = make_drive("piezo-bimorph", free, bias=bias).params["capacitance"]
-        sweep = sine_sweep(free, (100.0, 1000.0, 1500.0, 1750.0, 2000.0), bias / 2, bias / 4,
-                           drive_params={"bias": bias})
-        estimator = calibrate(sweep, bias, 1e9, c_fit)
+    estimator = estimator or free_estimator(bias)
     sc = leg_scene(transmission, act)
     if gains is None:
         gains = pid_gains(sc.choice.damping_ratio, sc.choice.first_frequency, frequency)
@@ -194,12 +245,9 @@ def run_leg(transmission: Transmission = SWING, cycles: int = 40, open_loop_cycl
     r = rollout(sc, None, cycles / frequency, drive_params={"bias": bias}, controller=ctrl,
                 sample_interval=sc.timestep, progress=False)
     # true foot phase per cycle, from the simulated tip deflection (lock-in of each cycle)
-    true = []
-    for n in range(len(ctrl.errors)):
-        sel = (r.time >= n / frequency) & (r.time < (n + 1) / frequency)
-        x = phasor(r.time[sel], r.tip_position[sel, 1], frequency)
-        true.append(np.angle(np.exp(1j * (transmission.desired_phase - np.pi / 2 - np.angle(x)))))
-    run = LegRun(transmission, r, np.degrees(ctrl.errors), np.degrees(true), open_loop_cycles,
+    true = phase_errors_per_cycle(r.time, r.tip_position[:, 1], frequency, transmission.desired_phase,
+                                  len(ctrl.errors))
+    run = LegRun(transmission, r, np.degrees(ctrl.errors), true, open_loop_cycles,
                  {"gains_kp_ki_kd": list(gains), "leg_mass_reflected_kg": sc.payload.mass,
                    "foot_mass_kg": sc.payload.mass / transmission.ratio**2,
                    "resonance_hz": sc.choice.first_frequency, "estimator": estimator.fit,

@@ -113,6 +113,21 @@ def calibrate(sweep: SineSweep, bias: float, r_fit: float, c_fit: float,
     return est
 
 
+def calibrate_on_free_actuator(actuator, bias: float, frequencies, **scene_kw) -> SelfSensingEstimator:
+    """Eqs. 7-9 calibrated once on the free (unloaded) ``actuator``'s sine sweep at ``bias``
+    (V) over ``frequencies`` (Hz), as seed 003 calibrates on the bench, not on the robot:
+    the drive's own resistance and capacitance stand in for the user's fixed-actuator
+    measurement (Table 2's extracted fits are unreliable), beta by eq. 8. ``scene_kw`` go to
+    the free actuator's :class:`mjeap.Scene`."""
+    from mjeap import Scene
+    from mjeap.drives import make_drive
+    from mjeap.frequency import sine_sweep
+    free = Scene(actuator, **scene_kw)
+    p = make_drive("piezo-bimorph", free, bias=bias).params
+    sweep = sine_sweep(free, tuple(frequencies), bias / 2, bias / 4, drive_params={"bias": bias})
+    return calibrate(sweep, bias, p["resistance"], p["capacitance"])
+
+
 def quasi_static_alpha(length: float, extension: float, area: float, f31: float, t_p: float, t_cf: float) -> float:
     """alpha (m/(A s)) of the uniform-curvature bimorph: the tip velocity (L/2 + l_ext) L kappa'
     over the motional current (1/2) f31 (t_p + t_cf) A kappa' (the Wood/Jafferis moment per

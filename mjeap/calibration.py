@@ -15,10 +15,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass, replace
 
+import numpy as np
+import scipy.linalg
 from scipy import optimize
 
 from .catalog import Actuator, get_actuator
 from .errors import ParameterError, check_positive
+from .modes import linearize
 from .scene import Scene
 
 
@@ -78,9 +81,6 @@ def clamp_stiffness_for_frequency(actuator, target_frequency: float, segments: i
     """The alternative residual, for comparison: the rotational stiffness (N m/rad) of a clamp
     spring in series with the root hinge that brings the first mode (modal analysis of the
     linearised scene) to ``target_frequency`` Hz."""
-    import numpy as np
-    import scipy.linalg
-    from .modes import linearize
     s = Scene(get_actuator(actuator), segments=segments)
     lin = linearize(s.model)
     j0 = int(s.model.jnt_dofadr[0])

@@ -156,6 +156,14 @@ class BeamLayout:
         return max(0, min(self.segments - 1, j))
 
 
+def block_inertia(mass: float, length: float, thickness: float, width: float) -> Tuple[float, float, float]:
+    """Principal inertias (kg m^2) of a solid block about its centre, in the beam's frame:
+    x along the beam (``length``), y the bending direction (``thickness``), z the hinge axis
+    (``width``); the rigid tip block's."""
+    return (mass * (thickness**2 + width**2) / 12, mass * (length**2 + width**2) / 12,
+            mass * (length**2 + thickness**2) / 12)
+
+
 def discretize(act: Actuator, segments: int) -> BeamLayout:
     """Midpoint-rule layout of ``act`` with ``segments`` hinges (see module docstring)."""
     if isinstance(segments, bool) or int(segments) != segments or segments < 2 or segments > 1000:

@@ -24,7 +24,7 @@ from typing import Dict, List, Optional
 import mujoco
 import numpy as np
 
-from .discretize import BeamLayout, Payload, clamp_rotation
+from .discretize import BeamLayout, Payload, block_inertia, clamp_rotation
 from .errors import UnknownNameError
 from .units import UnitSystem
 
@@ -230,11 +230,9 @@ def build_spec(layout: BeamLayout, representation: str = "hinge", orientation: s
         half = 0.5 * layout.extension_length / units.length
         ext.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=[half, 0.5 * t, 0.5 * layout.link_width[-1] / units.length],
                      pos=[half, 0, 0], rgba=[0.9, 0.9, 0.85, 1], contype=0, conaffinity=0)
-        # a solid block: length along x, thickness along y (the bending direction), width along z
         m = max(layout.extension_mass, 1e-6 * layout.link_mass[-1])
-        lx, ly, lz = layout.extension_length, t * units.length, layout.link_width[-1]
         _set_inertial(ext, m, [layout.extension_length / 2, 0, 0],
-                      [m * (ly**2 + lz**2) / 12, m * (lx**2 + lz**2) / 12, m * (lx**2 + ly**2) / 12], units)
+                      block_inertia(m, layout.extension_length, layout.thickness, layout.link_width[-1]), units)
     if payload is not None:
         j = layout.link_containing(min(payload.position, layout.length))
         host = spec.body(handles.link_bodies[j])

@@ -139,6 +139,19 @@ def _meta_markdown(meta: dict) -> str:
     return "\n".join(lines)
 
 
+def _log_outcome(rec, meta: dict, t, extra) -> None:
+    """The run's warnings and error (at its last sample's time) as text logs, then the
+    caller's ``extra(rec)`` entities."""
+    import rerun as rr
+    for level, texts in (("WARN", meta.get("warnings", [])), ("ERROR", [meta["error"]] if "error" in meta else [])):
+        for text in texts:
+            if len(t):
+                rec.set_time("time", duration=float(t[-1]))
+            rec.log("log", rr.TextLog(text, level=level))
+    if extra is not None:
+        extra(rec)
+
+
 def write_recording(path, result, scene, extra=None, views=(), deformation: float = None) -> Path:
     """Write ``result`` of a rollout of ``scene`` to ``path`` (.rrd); the file is flushed
     and closed before returning, also for a failed (partial) run. ``extra(rec)`` may log
@@ -211,16 +224,7 @@ def write_recording(path, result, scene, extra=None, views=(), deformation: floa
                 pp[:, 1:] *= scale
                 rec.send_columns("beam/payload", indexes=[tf], columns=rr.Points3D.columns(positions=pp @ R.T))
                 rec.log("beam/payload", rr.Points3D.from_fields(radii=[pay_r], colors=[[190, 50, 50]]), static=True)
-        for w in result.meta.get("warnings", []):
-            if n:
-                rec.set_time("time", duration=float(t[-1]))
-            rec.log("log", rr.TextLog(w, level="WARN"))
-        if "error" in result.meta:
-            if n:
-                rec.set_time("time", duration=float(t[-1]))
-            rec.log("log", rr.TextLog(result.meta["error"], level="ERROR"))
-        if extra is not None:
-            extra(rec)
+        _log_outcome(rec, result.meta, t, extra)
     finally:
         rec.flush()
         rec.disconnect()
@@ -276,15 +280,18 @@ def _geom_archetype(rr, model, g: int, length: float, color):
         return rr.Capsules3D(lengths=[2 * size[1]], radii=[size[0]], translations=[start], quaternions=[rot],
                              colors=[color])
     if t == T.mjGEOM_CYLINDER:
-        return rr.Cylinders3D(lengths=[2 * size[1]], radii=[size[0]], centers=[pos], rotations=[rot], colors=[color])
+        return rr.Cylinders3D(lengths=[2 * size[1]], radii=[size[0]], centers=[pos], quaternions=[rot], colors=[color],
+                              fill_mode="solid")
     return None
 
 
-def write_system_recording(path, result, system) -> Path:
+def write_system_recording(path, result, system, extra=None, views=()) -> Path:
     """Write a :class:`mjeap.system.SystemResult` to ``path`` (.rrd): every beam's
     centreline and tip (world frame, m), every other body's geoms (boxes, spheres,
     ellipsoids, capsules, cylinders) moving with their bodies, and per actuator its voltage
-    and tip curvature; the net contact force on every body that touches something."""
+    and tip curvature; the net contact force on every body that touches something.
+    ``extra(rec)`` may log more entities to the open ``rerun.RecordingStream``; ``views``
+    (rerun blueprint views) are placed first in the plots' column for them."""
     import rerun as rr
     import rerun.blueprint as rrb
     path = Path(path)
@@ -302,7 +309,7 @@ def write_system_recording(path, result, system) -> Path:
     left = rrb.Vertical(rrb.Spatial3DView(origin="/world", name="system (m)",
                                           line_grid=rrb.archetypes.LineGrid3D(visible=True)),
                         rrb.TextDocumentView(origin="/meta", name="run parameters"), row_shares=[3, 1])
-    bp = rrb.Blueprint(rrb.Horizontal(left, rrb.Vertical(*groups), column_shares=[3, 2]),
+    bp = rrb.Blueprint(rrb.Horizontal(left, rrb.Vertical(*views, *groups), column_shares=[3, 2]),
                        rrb.BlueprintPanel(state="collapsed"), rrb.SelectionPanel(state="collapsed"),
                        rrb.TimePanel(state="collapsed", timeline="time", play_state="paused"))
     rec = rr.RecordingStream("mjeap", recording_id=f"system-{'-'.join(names)}")
@@ -364,10 +371,7 @@ def write_system_recording(path, result, system) -> Path:
             rec.log(ent, rr.SeriesLines(names=f"{result.body_names[b]}: |contact force| (N)"), static=True)
             rec.send_columns(ent, indexes=[rr.TimeColumn("time", duration=t)],
                              columns=rr.Scalars.columns(scalars=np.linalg.norm(result.contact_force[:, b], axis=1)))
-        if "error" in result.meta:
-            if n:
-                rec.set_time("time", duration=float(t[-1]))
-            rec.log("log", rr.TextLog(result.meta["error"], level="ERROR"))
+        _log_outcome(rec, result.meta, t, extra)
     finally:
         rec.flush()
         rec.disconnect()

@@ -215,19 +215,20 @@ class Scene:
         if self.representation != "hinge":
             self.spec.add_numeric(name=DOF_DAMPING_FIELD, data=list(dof_damping))
         T1, T_el = 2 * np.pi / w1, 2 * np.pi / w_el
-        h_stab = stability_limit(lin, dof_damping, self.integrator, h_max=min(T1, T_el))
+        T_short = min(T1, T_el)
+        h_stab = stability_limit(lin, dof_damping, self.integrator, h_max=T_short)
         if self.representation != "hinge":
             # the cable's tangent stiffness stops being diagonal in the joint coordinates
             # once bent (the stiff in-plane direction couples into twist), so diagonal
             # damping no longer damps it: check the design bend too
             bent = self._uniform_arc_qpos(model, self.max_bend)
             h_stab = min(h_stab, stability_limit(linearize(model, qpos=bent), dof_damping,
-                                                 self.integrator, h_max=min(T1, T_el)))
+                                                 self.integrator, h_max=T_short))
         # accuracy: 50 steps per period of the first mode, and of the first mode without
         # gravity's load (near the buckling load T1 grows without bound, the beam's elastic
         # response to a drive or a push does not). The drives are discretised exactly
         # (zero-order hold), so their time constants set no bound of their own.
-        h_acc = min(T1, T_el) / STEPS_PER_PERIOD
+        h_acc = T_short / STEPS_PER_PERIOD
         # backward Euler on the hinge springs damps like Rayleigh damping with beta = h
         numerical = self.integrator == "discrete" and self.representation == "hinge"
         if numerical and beta > 0:

@@ -38,6 +38,9 @@ class SectionProperties:
     width: float               # widest layer, m
     interfaces: tuple          # z_0 = 0, z_1, ..., z_n, m
     plane_strain: bool
+    layer_moduli: tuple = ()   # E_hat_i (plane strain or not, as above), Pa
+    layer_widths: tuple = ()   # w_i, m
+    layer_inertias: tuple = ()  # I_i about the neutral axis (eq. 3.4), m^4
 
 
 def multilayer_section(layers: Sequence[SectionLayer],
@@ -79,4 +82,7 @@ def multilayer_section(layers: Sequence[SectionLayer],
         width=float(w.max()),
         interfaces=tuple(float(v) for v in z),
         plane_strain=plane_strain,
+        layer_moduli=tuple(float(v) for v in Eh),
+        layer_widths=tuple(float(v) for v in w),
+        layer_inertias=tuple(float(v) for v in I),
     )

@@ -197,6 +197,27 @@ def attach(spec: mujoco.MjSpec, actuator, *, prefix: str, site: Optional[str] = 
     return AttachedActuator(prefix + "/", twin, drv, nat, contact)
 
 
+def add_transmission(spec: mujoco.MjSpec, actuator: AttachedActuator, joint: str, ratio: float) -> None:
+    """Couple the host's hinge ``joint`` to an attached ``actuator``'s tip: joint angle (rad)
+    = ``ratio`` (rad/m, signed) x the tip's deflection linearised in the hinge angles (m),
+    the small-motion transmission seed 003 states (RoboBee T_eff, HAMR T / leg length). A
+    fixed tendon '<prefix>tip_deflection' sums the actuator's hinges with coefficients
+    x_tip - x_j, a tendon '<prefix>transmission' reads the joint, and a tendon equality
+    holds one at ``ratio`` times the other."""
+    if not np.isfinite(ratio) or ratio == 0:
+        raise ParameterError("ratio", ratio, "a finite, non-zero transmission ratio in rad/m")
+    if spec.joint(joint) is None:
+        raise UnknownNameError("joint", joint, [j.name for j in spec.joints])
+    lay, u = actuator.twin.layout, actuator.twin.units
+    tip = spec.add_tendon(name=actuator.name("tip_deflection"))
+    for j, x in zip(actuator.joints, lay.hinge_x):
+        tip.wrap_joint(j, (lay.tip_x - x) / u.length)
+    spec.add_tendon(name=actuator.name("transmission")).wrap_joint(joint, 1.0)
+    eq = spec.add_equality(type=mujoco.mjtEq.mjEQ_TENDON, name1=actuator.name("transmission"),
+                           name2=actuator.name("tip_deflection"))
+    eq.data[:5] = [0.0, ratio * u.length, 0.0, 0.0, 0.0]
+
+
 @dataclass
 class SystemResult:
     """A system rollout, SI: one :class:`~mjeap.rollout.RolloutResult` per actuator (by
@@ -315,6 +336,23 @@ class System:
     def time(self) -> float:
         return self.data.time * self.units.time
 
+    def drive_observer(self, prefix: str):
+        """A copy of the drive of the actuator under ``prefix`` that reads this system's beam
+        and never acts on it (the native model drives it): call its ``step(v, dt)`` with the
+        voltage (V) held over each step, in lockstep with :meth:`step`, and its
+        ``signals()`` (the drive current, A, ...) read what a lockstep loop would, e.g. for
+        a controller that senses the actuator's own current."""
+        from .drives import make_drive
+        from .drives.base import ReadOnlyPart
+        i = self.index(prefix)
+        a = self.actuators[i]
+        if a.drive is None:
+            raise ParameterError("prefix", prefix, "an actuator attached with a drive (this one is passive)")
+        obs = make_drive(a.drive.name, a.twin, **a.drive.params)
+        obs.part = ReadOnlyPart(self.parts[i])
+        obs.reset()
+        return obs
+
     # ------------------------------------------------------------------ state
     def reset(self, initial_curvatures: Union[float, Sequence[float]] = 0.0) -> None:
         """Reset to the host's qpos0 with each beam a uniform arc of its initial curvature
@@ -393,19 +431,44 @@ class System:
         dist = [d.contact[i].dist for i in range(d.ncon)]
         return max(0.0, -min(dist, default=0.0)) * self.units.length
 
+    def _control(self, voltages, v_steps, k: int) -> None:
+        """Hold a controller's ``voltages`` (V) from step ``k`` on, each checked first."""
+        for a, vs, v in zip(self.actuators, v_steps, self._per_actuator("controller voltages", voltages)):
+            if vs is None:
+                continue
+            if v is None:
+                if k:
+                    vs[k] = vs[k - 1]
+                continue
+            lo, hi = a.drive.voltage_range()
+            if not (lo - 1e-12 <= v <= hi + 1e-12):
+                raise ParameterError(f"controller voltage of '{a.prefix.rstrip('/')}'", f"{v:.6g} V at t = {self.time:.6g} s",
+                                     f"a voltage in the safe range [{lo:g}, {hi:g}] V of {a.twin.actuator.id}")
+            vs[k] = v
+
     # ------------------------------------------------------------------ rollout
     def rollout(self, voltages, duration: float, initial_curvatures: Union[float, Sequence[float]] = 0.0,
                 sample_interval: Optional[float] = None, rrd: Union[str, Path, None] = None,
-                on_sample=None) -> SystemResult:
+                on_sample=None, controller=None) -> SystemResult:
         """Run for ``duration`` s with one voltage per actuator (waveform text,
         :class:`~mjeap.Waveform`, callable v(t) or None for its rest voltage; a list or a dict
         by prefix). Returns a :class:`SystemResult`; with ``rrd`` a Rerun recording (written
         also when the run fails: it then ends with the error). ``on_sample(system)`` is
-        called at every sample (e.g. to move a mocap body)."""
+        called at every sample (e.g. to move a mocap body). ``controller(t, system)``
+        (``voltages`` then None) is called before every step and returns the voltages (V) to
+        hold over it, one per actuator or a dict by prefix (None: unchanged); each is checked
+        against its drive's safe range. It may read the system's state; a controller that
+        senses an actuator's current steps a :meth:`drive_observer` with them."""
         from .rollout import (_Samples, _sample_steps, _voltage_steps, _waveform, check_outputs, check_work,
                               write_outputs)
         duration = check_positive("duration", duration, "s")
         check_outputs(rrd=rrd)
+        if controller is not None:
+            if voltages is not None and any(v is not None for v in self._per_actuator("voltages", voltages)):
+                raise ParameterError("voltages", voltages, "None when a controller sets the voltages")
+            if not callable(controller):
+                raise ParameterError("controller", controller, "a callable controller(t, system) -> voltages")
+            voltages = None
         waves = [None if w is None else _waveform(w, duration) for w in self._per_actuator("voltages", voltages)]
         dt = self.timestep
         n_steps = check_work(duration, dt)
@@ -431,9 +494,12 @@ class System:
                 a.drive.native_prepare(v)
                 a.drive.part = p
         active = [(i, v) for i, v in zip(self.actuator_ids, v_steps) if v is not None]
+        ctrl_name = None if controller is None else getattr(controller, "name", type(controller).__name__)
         meta = {"actuators": {a.prefix.rstrip("/"): {"actuator": a.twin.actuator.id,
                                                      "drive": None if a.drive is None else a.drive.describe(),
-                                                     "voltage": None if w is None else getattr(w, "text", str(w))}
+                                                     "voltage": (f"controller: {ctrl_name}" if controller is not None
+                                                                 and a.drive is not None else
+                                                                 None if w is None else getattr(w, "text", str(w)))}
                               for a, w in zip(self.actuators, waves)},
                 "duration_s": duration, "steps": n_steps, "timestep_s": dt, "timestep_reason": self.timestep_reason,
                 "units": self.units.describe()}
@@ -455,9 +521,13 @@ class System:
         error = None
         wall0 = _time.perf_counter()
         try:
+            if controller is not None:          # the voltage over step 0 is the first sample's
+                self._control(controller(0.0, self), v_steps, 0)
             sample(0, 0)
             nxt = 1
             for k in range(n_steps):
+                if controller is not None and k:
+                    self._control(controller(k * dt, self), v_steps, k)
                 for i, v in active:
                     d.ctrl[i] = v[k]
                 mujoco.mj_step(m, d)

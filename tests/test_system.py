@@ -42,6 +42,31 @@ def test_attached_at_a_tilted_site_moves_as_its_scene(contact, integrator):
                                atol=1e-6 * np.abs(ref.tip_position).max())
 
 
+def _native_actuators():
+    from mjeap import native
+    from mjeap.catalog import actuator_ids
+    from mjeap.drives import make_drive
+    return [a for a in actuator_ids() if native.why_not(Scene(a), make_drive(None, Scene(a))) is None]
+
+
+@pytest.mark.parametrize("actuator", _native_actuators())
+def test_every_native_drive_attached_moves_and_reads_as_its_scene(actuator):
+    """Each catalog actuator's own drive, attached alone and stepped by the system: tip
+    curvature and every drive signal equal the Scene's native rollout's to 1e-6 of their
+    largest values. (The drive's signals are replayed beside the native model; a replay that
+    wrote its moments into the system's beam doubled a piezo bimorph's deflection.)"""
+    spec = host('<site name="mount"/>')
+    a = attach(spec, actuator, site="mount", prefix="act", contact=False)
+    s = System(spec, [a])
+    lo, hi = a.drive.voltage_range()
+    v = f"step:{lo + 0.75 * (hi - lo)}V"
+    duration = 300 * s.timestep
+    r = s.rollout([v], duration).actuators["act"]
+    ref = rollout(Scene(actuator, orientation=a.twin.rotation), v, duration, engine="native", progress=False)
+    for got, want in [(r.tip_curvature, ref.tip_curvature)] + [(r.signals[k], ref.signals[k]) for k in ref.signals]:
+        assert np.max(np.abs(got - want)) <= 1e-6 * max(np.abs(want).max(), 1e-300)
+
+
 TWO = ('<body name="base"><site name="a" pos="0 0 0" quat="0.7071068 0.7071068 0 0"/>'
        '<site name="b" pos="0 30 0" quat="0.7071068 0.7071068 0 0"/></body>')
 
@@ -157,3 +182,35 @@ def test_si_host_with_micro_parts_is_refused_with_a_unit_system_that_works():
 def test_host_gravity_in_other_units_is_refused():
     with pytest.raises(ParameterError, match="gravity.*-0.00980665"):
         attach(host('<site name="mount"/>', gravity="0 0 -9.81"), "pedot-micro", site="mount", prefix="a")
+
+
+def test_a_controller_drives_the_system_as_the_waveform_it_returns():
+    """A controller returning the square wave's value before every step gives the same run
+    as the waveform (to round-off); one returning a voltage outside the drive's safe range
+    stops the run with the actuator, the voltage and the range named."""
+    from mjeap.waveforms import parse_waveform
+    spec = host('<site name="mount"/>')
+    a = attach(spec, "pedot-micro", site="mount", prefix="act", contact=False)
+    s = System(spec, [a])
+    w = parse_waveform("square:1V@5Hz")
+    ref = s.rollout(["square:1V@5Hz"], 0.2).actuators["act"]
+    got = s.rollout(None, 0.2, controller=lambda t, sy: [float(w(np.array([t]))[0])]).actuators["act"]
+    np.testing.assert_allclose(got.tip_curvature, ref.tip_curvature, rtol=0, atol=1e-9 * np.abs(ref.tip_curvature).max())
+    np.testing.assert_allclose(got.voltage, ref.voltage, atol=1e-12)
+    with pytest.raises(ParameterError, match="controller voltage of 'act'.*safe range"):
+        s.rollout(None, 0.2, controller=lambda t, sy: [5.0])
+    with pytest.raises(ParameterError, match="voltages"):
+        s.rollout(["step:1V"], 0.2, controller=lambda t, sy: [1.0])
+
+
+def test_transmission_inputs_are_named():
+    """add_transmission refuses a zero or non-finite ratio and an unknown joint, naming them."""
+    from mjeap.system import add_transmission
+    spec = host('<site name="mount"/><body name="arm"><joint name="stroke" type="hinge"/>'
+                '<geom type="sphere" size="1" contype="0" conaffinity="0"/></body>')
+    a = attach(spec, "pzt-robobee", site="mount", prefix="act", contact=False)
+    for bad in (0.0, float("nan")):
+        with pytest.raises(ParameterError, match="ratio"):
+            add_transmission(spec, a, "stroke", bad)
+    with pytest.raises(UnknownNameError, match="nope"):
+        add_transmission(spec, a, "nope", 4000.0)

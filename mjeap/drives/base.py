@@ -229,9 +229,16 @@ class Drive:
 
     def native_signals(self, k: int, part, handles, prefix: str = "") -> Dict[str, float]:
         """The drive's signals after step ``k`` of a native run, the part holding that
-        state: by default the loop drive replayed to step k (:meth:`seek`)."""
-        self.seek(k)
-        return self.signals()
+        state: by default the loop drive replayed to step k (:meth:`seek`) on a read-only
+        view of its part, so that the replay adds no moment or stiffness to a beam the
+        native model already drives (a system's, :mod:`mjeap.system`)."""
+        own = self.part
+        self.part = ReadOnlyPart(own)
+        try:
+            self.seek(k)
+            return self.signals()
+        finally:
+            self.part = own
 
     def native_signal_history(self, ks: np.ndarray, states: np.ndarray, part, handles,
                               prefix: str = "") -> Optional[Dict[str, np.ndarray]]:
@@ -248,3 +255,21 @@ class Drive:
 
     def describe(self) -> str:
         return f"{self.name} ({self.model_used})" if self.model_used else self.name
+
+
+class ReadOnlyPart:
+    """A beam part seen by a replayed drive: reads pass through, the drive's writes (its
+    moments, its stiffness scale) are kept here and never reach the model."""
+
+    def __init__(self, part):
+        self._part = part
+        self._stiffness_scale = getattr(part, "_stiffness_scale", 1.0)
+
+    def __getattr__(self, name):
+        return getattr(self._part, name)
+
+    def set_internal_moments(self, moments) -> None:
+        pass
+
+    def set_bending_stiffness_scale(self, scale) -> None:
+        self._stiffness_scale = scale

@@ -50,16 +50,13 @@ _Q = (f"fitted: least squares on 60PVDF's free tip displacements ({_T}, Table 4.
 def section_moment_of_inertia(actuator) -> float:
     """Sum of the layers' second moments of area about the stack's neutral axis (m^4), each
     with its own width (thesis eq. 3.4, Table 3.7)."""
-    sec = actuator.section_at(0.0)
-    zc, z = sec.neutral_axis, sec.interfaces
-    return float(sum((l.width if l.width is not None else float(actuator.width_at(0.0)))
-                     * ((z[i + 1] - zc) ** 3 - (z[i] - zc) ** 3) / 3 for i, l in enumerate(actuator.layers)))
+    return float(sum(actuator.section_at(0.0).layer_inertias))
 
 
 def maxwell_stress_model(actuator, voltage: float, relative_permittivity: float = 45.0) -> Dict[str, float]:
     """The thesis's Maxwell-stress chain (eqs. 3.7-3.11) for a catalog unimorph, SI."""
     act = actuator
-    active = next(l for l in act.layers if l.name == "terpolymer")
+    active = act.layers[active_layer(act)]
     E = voltage / active.thickness
     S = EPS0 * relative_permittivity * E**2 / active.youngs_modulus
     sigma = active.youngs_modulus * S
@@ -73,12 +70,14 @@ def maxwell_stress_model(actuator, voltage: float, relative_permittivity: float 
 def eigenstrain_moment(actuator, strain: float) -> float:
     """Moment (N m) of a free in-plane strain of the active layer, multilayer beam."""
     sec = actuator.section_at(0.0)
-    i = next(k for k, l in enumerate(actuator.layers) if l.name == "terpolymer")
-    lay = actuator.layers[i]
-    z0, z1 = sec.interfaces[i], sec.interfaces[i + 1]
-    E = lay.youngs_modulus / (1 - lay.poisson_ratio**2) if sec.plane_strain else lay.youngs_modulus
-    w = lay.width if lay.width is not None else float(actuator.width_at(0.0))
-    return E * w * strain * ((z1 - sec.neutral_axis) ** 2 - (z0 - sec.neutral_axis) ** 2) / 2
+    i = active_layer(actuator)
+    z0, z1 = sec.interfaces[i] - sec.neutral_axis, sec.interfaces[i + 1] - sec.neutral_axis
+    return sec.layer_moduli[i] * sec.layer_widths[i] * strain * (z1**2 - z0**2) / 2
+
+
+def active_layer(actuator) -> int:
+    """Index of the terpolymer layer in the stack."""
+    return next(k for k, l in enumerate(actuator.layers) if l.name == "terpolymer")
 
 
 @register_drive
@@ -106,7 +105,7 @@ class ElectrostrictiveDrive(Drive):
         self.model_used = {"maxwell": "thesis Maxwell-stress model, eqs. 3.7-3.11",
                            "eigenstrain": "electrostrictive eigenstrain S = Q E^2 in the layer stack"}[self.params["model"]]
         act = scene.actuator
-        self.t_active = next(l for l in act.layers if l.name == "terpolymer").thickness
+        self.t_active = act.layers[active_layer(act)].thickness
         slopes = SLOPES.get(act.id)
         if self.params["stiffening"] and slopes is None:
             raise ParameterError("stiffening", True, "False for an actuator without measured slopes",

@@ -10,6 +10,7 @@ import numpy as np
 
 from .. import analytical as an
 from ..calibration import clamp_stiffness_for_frequency, with_residual
+from ..discretize import block_inertia
 from ..rollout import rollout
 from ..scene import Scene
 from .core import Experiment, experiment
@@ -29,7 +30,7 @@ def _tip_block(act):
     block: a solid block of tip width x thickness x length, residual included."""
     p = act.planform
     m, l = p.tip_block_mass, p.extension_length
-    return m, 0.5 * l, m * (l**2 + act.thickness**2) / 12.0
+    return m, 0.5 * l, block_inertia(m, l, act.thickness, p.tip_width)[2]
 
 
 def _plate_frequency(act, guess):

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..drives import make_drive
 from ..catalog import get_actuator
-from ..drives.electrostrictive import FIELDS, SLOPES, eigenstrain_moment, maxwell_stress_model
+from ..drives.electrostrictive import FIELDS, SLOPES, active_layer, eigenstrain_moment, maxwell_stress_model
 from ..scene import Scene
 from .core import Experiment, experiment
 
@@ -61,11 +61,8 @@ def active_share_of_ei(actuator_id: str) -> float:
     """Share of the layer model's EI carried by the terpolymer layer (-)."""
     act = get_actuator(actuator_id)
     sec = act.section_at(0.0)
-    z, zc = sec.interfaces, sec.neutral_axis
-    i = next(k for k, l in enumerate(act.layers) if l.name == "terpolymer")
-    lay = act.layers[i]
-    E = lay.youngs_modulus / (1 - lay.poisson_ratio**2) if sec.plane_strain else lay.youngs_modulus
-    return float(E * lay.width * ((z[i + 1] - zc) ** 3 - (z[i] - zc) ** 3) / 3 / sec.flexural_rigidity)
+    i = active_layer(act)
+    return sec.layer_moduli[i] * sec.layer_inertias[i] / sec.flexural_rigidity
 
 
 def held(scene, voltage: float):
@@ -118,7 +115,7 @@ def metello(quick: bool = False) -> Experiment:
         act = scene.actuator
         L = scene.layout.length
         EI = float(act.flexural_rigidity_at(0.0)[0])
-        t_a = next(l for l in act.layers if l.name == "terpolymer").thickness
+        t_a = act.layers[active_layer(act)].thickness
         # load-displacement: the beam's slope at 0 V and under the held fields (no stiffening)
         slopes = []
         for i, E in enumerate(FIELDS):
