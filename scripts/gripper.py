@@ -30,8 +30,9 @@ R sin(theta) beside the bead's centre. Point contacts with Coulomb friction (MuJ
 condim 3, a "hard finger") resist no moment about that line, so the bead's weight rolls it
 down between the fingers with both contacts sticking, at any grip force: two hard-finger
 contacts are not force closure (grasping theory: Murray, Li & Sastry 1994, ch. 5). The
-simulation shows it (``hard_finger``: the bead stays on the table and spins at
-omega = v_lift / (R sin theta) while the fingers rise past it). Held beads are held through
+simulation shows it (``hard_finger``: the bead stays on the table and turns about the
+gripping axis while the fingers rise past it, its contact points rolling up with them:
+(turn) R sin(theta) = 1.05 x the fingers' rise, the 5 % slip at the contacts). Held beads are held through
 contact patches, which resist that moment: MuJoCo's soft-finger contact (condim 4) with a
 torsional friction of MU_TORSION = 0.1 mm, the moment per newton of normal force of a
 patch of radius 16 mu_t / (3 pi mu) = 0.34 mm under Hertz pressure: a compliant fingertip,
@@ -230,15 +231,29 @@ def min_lift_voltage(low: float, high: float, rtol: float = 0.02, hold: float = 
 
 def hard_finger_check(voltage: float = 2.0, duration: float = 1.2, lift_at: float = 0.4) -> dict:
     """Hard-finger contacts (condim 3): the base lifts at ``lift_at``; the bead stays put and
-    spins so that its contact points rise with the fingers: omega R sin(theta) = v_lift."""
+    rolls so that its contact points rise with the fingers. Over the middle 60 % of the rise:
+    the bead's turn about y (from its orientation, sample to sample) times R sin(theta), theta
+    the contact's tilt at that sample, against the slide's rise (``rolling_over_lift``, 1 for
+    pure rolling), and the bead's own rise."""
+    from scipy.spatial.transform import Rotation
+
     r = grip(voltage, duration, lift_at=lift_at, system=build(soft_finger=False))
-    rising = (r.time > lift_at + 0.2 * LIFT_TIME) & (r.time < lift_at + 0.8 * LIFT_TIME)
-    v_lift = LIFT / LIFT_TIME
-    rolling = np.abs(r.spin[rising]) * BEAD_RADIUS * np.sin(r.tilt[rising])
-    return {"voltage_v": voltage, "two_mu_f_over_mg": float(2 * MU * np.median(r.force[rising]) / (BEAD_MASS * G)),
+    k0, k1 = np.searchsorted(r.time, [lift_at + 0.2 * LIFT_TIME, lift_at + 0.8 * LIFT_TIME])
+    b = r.result.body("bead")
+    q = Rotation.from_quat(r.result.body_quat[k0:k1 + 1, b], scalar_first=True)
+    steps = (q[1:] * q[:-1].inv()).as_rotvec()              # sample to sample (each < pi), world
+    turn = np.sum(steps, axis=0)
+    tilt = r.tilt[k0:k1 + 1]
+    theta = float(np.median(tilt))
+    rolled = np.sum(np.abs(steps[:, 1]) * BEAD_RADIUS * np.sin(0.5 * (tilt[1:] + tilt[:-1])))  # the tilt grows
+    lift = r.base_rise[k1] - r.base_rise[k0]
+    return {"voltage_v": voltage,
+            "two_mu_f_over_mg": float(2 * MU * np.median(r.force[k0:k1 + 1]) / (BEAD_MASS * G)),
             "bead_rise_m": float(r.bead_rise[-1]), "base_rise_m": float(r.base_rise[-1]),
-            "tilt_deg": float(np.degrees(np.median(r.tilt[rising]))),
-            "rolling_speed_over_lift_speed": float(np.median(rolling) / v_lift)}
+            "tilt_deg": float(np.degrees(theta)), "bead_turn_deg": float(np.degrees(np.linalg.norm(turn))),
+            "turn_axis": (turn / np.linalg.norm(turn)).tolist(),
+            "rolling_over_lift": float(rolled / lift),
+            "bead_rise_over_lift": float((r.bead_rise[k1] - r.bead_rise[k0]) / lift)}
 
 
 def write_recording(path, system: System, run: GripRun, reference: np.ndarray) -> None:
@@ -246,7 +261,7 @@ def write_recording(path, system: System, run: GripRun, reference: np.ndarray) -
     the bead's and the base's rise."""
     import rerun as rr
     import rerun.blueprint as rrb
-    from mjeap.recording import write_system_recording
+    from mjeap.recording import write_system_recording, x_axis, y_axis
 
     def extra(rec):
         tc = [rr.TimeColumn("time", duration=run.time)]
@@ -258,8 +273,10 @@ def write_recording(path, system: System, run: GripRun, reference: np.ndarray) -
             rec.log(ent, rr.SeriesLines(names=label, colors=[colour]), static=True)
             rec.send_columns(ent, indexes=tc, columns=rr.Scalars.columns(scalars=values))
 
-    views = (rrb.TimeSeriesView(origin="/gripper/force", name="grip force (N): simulated vs closed form"),
-             rrb.TimeSeriesView(origin="/gripper/rise", name="rise above start (m): base and bead"))
+    views = (rrb.TimeSeriesView(origin="/gripper/force", name="grip force (N): simulated vs closed form",
+                                axis_y=y_axis(run.force, reference), axis_x=x_axis(run.time)),
+             rrb.TimeSeriesView(origin="/gripper/rise", name="rise above start (m): base and bead",
+                                axis_y=y_axis(run.base_rise, run.bead_rise), axis_x=x_axis(run.time)))
     write_system_recording(path, run.result, system, extra=extra, views=views)
 
 
