@@ -87,10 +87,21 @@ def y_axis(*series):
     return rrb.ScalarAxis(range=(lo - pad, hi + pad))
 
 
-def _ts(origin: str, name: str, *series, contents=None):
+def x_axis(time):
+    """The whole run on the time axis (``time`` in s), not the viewer's default window
+    around the cursor, which shows a long run's first half only."""
+    import rerun.blueprint as rrb
+    if time is None or not len(time):
+        return None
+    start, end = float(time[0]), float(time[-1])
+    return rrb.TimeAxis(view_range=rrb.TimeRange(start=rrb.TimeRangeBoundary.absolute(seconds=start),
+                                                 end=rrb.TimeRangeBoundary.absolute(seconds=max(end, start + 1e-9))))
+
+
+def _ts(origin: str, name: str, *series, contents=None, time=None):
     import rerun.blueprint as rrb
     kw = {} if contents is None else {"contents": contents}
-    return rrb.TimeSeriesView(origin=origin, name=name, axis_y=y_axis(*series), **kw)
+    return rrb.TimeSeriesView(origin=origin, name=name, axis_y=y_axis(*series), axis_x=x_axis(time), **kw)
 
 
 def blueprint(result=None, scale: float = 1.0, grid_spacing: float = 1e-3, extra_views=()):
@@ -100,18 +111,19 @@ def blueprint(result=None, scale: float = 1.0, grid_spacing: float = 1e-3, extra
     import rerun.blueprint as rrb
     r = result
     signals = {} if r is None else r.signals
+    t = None if r is None else r.time
     drive_views = [_ts("/plots/drive", f"drive ({unit})", *[signals[k] for k in keys],
-                       contents=[f"/plots/drive/{_slug(k)}" for k in keys])
+                       contents=[f"/plots/drive/{_slug(k)}" for k in keys], time=t)
                    for unit, keys in _drive_units(signals).items()]
     title = "beam (m)" + ("" if scale == 1 else f", deformation shown x{scale:g}")
     tip = (None, None) if r is None else (r.tip_position[:, 0], r.tip_position[:, 1])
     # two rows of two, tall enough for labelled y ticks; the less central quantities as tabs
     series = [_ts("/plots/tip_curvature", "tip curvature (1/m)", *(() if r is None else
-                                                                   (r.tip_curvature, r.reference_curvature))),
-              _ts("/plots/voltage", "voltage (V)", None if r is None else r.voltage),
-              _ts("/plots/tip_position/y", "tip deflection y (m)", tip[1]),
-              rrb.Tabs(*drive_views, _ts("/plots/tip_angle", "tip angle (rad)", None if r is None else r.tip_angle),
-                       _ts("/plots/tip_position/x", "tip axial x (m)", tip[0]), name="drive and tip")]
+                                                                   (r.tip_curvature, r.reference_curvature)), time=t),
+              _ts("/plots/voltage", "voltage (V)", None if r is None else r.voltage, time=t),
+              _ts("/plots/tip_position/y", "tip deflection y (m)", tip[1], time=t),
+              rrb.Tabs(*drive_views, _ts("/plots/tip_angle", "tip angle (rad)", None if r is None else r.tip_angle, time=t),
+                       _ts("/plots/tip_position/x", "tip axial x (m)", tip[0], time=t), name="drive and tip")]
     # Rerun's own camera frames the beam; an explicit EyeControls3D position was tried and
     # rendered off target (headless, Rerun 0.41)
     left = rrb.Vertical(rrb.Spatial3DView(origin="/beam", name=title,
@@ -299,13 +311,14 @@ def write_system_recording(path, result, system, extra=None, views=()) -> Path:
     m, L = system.model, system.units.length
     names = [a.prefix.rstrip("/") for a in system.actuators]
     res = result.actuators
-    groups = [rrb.Vertical(_ts(f"/plots/{n}/tip_curvature", f"{n}: tip curvature (1/m)", res[n].tip_curvature),
-                           _ts(f"/plots/{n}/voltage", f"{n}: voltage (V)", res[n].voltage), name=n)
+    t = result.time
+    groups = [rrb.Vertical(_ts(f"/plots/{n}/tip_curvature", f"{n}: tip curvature (1/m)", res[n].tip_curvature, time=t),
+                           _ts(f"/plots/{n}/voltage", f"{n}: voltage (V)", res[n].voltage, time=t), name=n)
               for n in names]
     touched = [b for b in range(m.nbody) if len(result.time) and np.abs(result.contact_force[:, b]).max() > 0]
     if touched:
         groups.append(_ts("/plots/contact", "contact force (N)",
-                          *[np.linalg.norm(result.contact_force[:, b], axis=1) for b in touched]))
+                          *[np.linalg.norm(result.contact_force[:, b], axis=1) for b in touched], time=t))
     left = rrb.Vertical(rrb.Spatial3DView(origin="/world", name="system (m)",
                                           line_grid=rrb.archetypes.LineGrid3D(visible=True)),
                         rrb.TextDocumentView(origin="/meta", name="run parameters"), row_shares=[3, 1])

@@ -49,27 +49,46 @@ class ContactParameters:
       near 1 makes the contact nearly rigid. At rest the penetration is
       F (1 - d) (timeconst)^2 / m_eff for a force F on an effective mass m_eff; for the
       actuators here that is far below their thickness (tested: a beam pressing on a block).
-    * ``margin`` 0, ``friction`` (sliding, torsional, rolling) = (0.5, 0.005, 0.0001), an
-      elliptic cone (``cone``), condim 3 on the beam's geoms.
+    * ``margin`` 0, ``friction`` = (sliding coefficient, torsional m, rolling m) =
+      (0.5, 5 um, 0.1 um), an elliptic cone (``cone``). The torsional and rolling
+      coefficients are lengths (the moment they resist per newton of normal force) and act
+      only where a geom asks for them (condim 4 or 6; the beams' geoms are condim 3).
+    * ``impratio``: the friction rows' regularisation is the normal row's divided by it.
+      MuJoCo's friction is soft: under a steady tangential load f a sticking contact creeps
+      at about f R / b (R its regulariser, b = 1 / h its damping); impratio > 1 cuts the
+      creep by that factor (elliptic cones only).
     """
 
     timeconst_steps: float = 2.0
     dampratio: float = 1.0
     impedance: tuple = (0.99, 0.999)
     width_fraction: float = 0.1
-    friction: tuple = (0.5, 0.005, 0.0001)
+    friction: tuple = (0.5, 5e-6, 1e-7)
     margin: float = 0.0
     cone: str = "elliptic"
+    impratio: float = 1.0
 
-    def apply(self, spec: mujoco.MjSpec, h: float, thickness: float) -> None:
+    def __post_init__(self):
+        if len(self.friction) != 3 or not all(np.isfinite(f) and f >= 0 for f in self.friction):
+            raise ParameterError("friction", self.friction, "(sliding >= 0, torsional >= 0 m, rolling >= 0 m)")
+        if self.cone not in ("elliptic", "pyramidal"):
+            raise ParameterError("cone", self.cone, "'elliptic' or 'pyramidal'")
+        if not (np.isfinite(self.impratio) and self.impratio >= 1.0):
+            raise ParameterError("impratio", self.impratio, "a ratio >= 1")
+
+    def apply(self, spec: mujoco.MjSpec, h: float, thickness: float, length: float = 1e-3) -> None:
+        """Set the host's contact override: ``h`` and ``thickness`` internal, ``length`` the
+        SI size (m) of one internal length unit."""
         o = spec.option
         o.disableflags &= ~int(mujoco.mjtDisableBit.mjDSBL_CONTACT)
         o.enableflags |= int(mujoco.mjtEnableBit.mjENBL_OVERRIDE)
         o.o_solref = [self.timeconst_steps * h, self.dampratio]
         o.o_solimp = [self.impedance[0], self.impedance[1], self.width_fraction * thickness, 0.5, 2.0]
         o.o_margin = self.margin
-        o.o_friction = [self.friction[0], self.friction[0], self.friction[1], self.friction[2], self.friction[2]]
+        mu, torsion, rolling = self.friction[0], self.friction[1] / length, self.friction[2] / length
+        o.o_friction = [mu, mu, torsion, rolling, rolling]
         o.cone = {"elliptic": mujoco.mjtCone.mjCONE_ELLIPTIC, "pyramidal": mujoco.mjtCone.mjCONE_PYRAMIDAL}[self.cone]
+        o.impratio = self.impratio
 
 
 @dataclass
@@ -285,7 +304,7 @@ class System:
         spec.option.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_AUTORESET)
         if contact is not None and any(a.contact for a in self.actuators):
             t_min = min(a.twin.layout.thickness for a in self.actuators if a.contact) / units.length
-            contact.apply(spec, h / units.time, t_min)
+            contact.apply(spec, h / units.time, t_min, units.length)
         self.contact = contact
         native.add_units(spec, units)
         try:

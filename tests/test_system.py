@@ -10,7 +10,7 @@ import pytest
 
 from mjeap import Scene, UnitSystem, rollout
 from mjeap.errors import ParameterError, UnknownNameError
-from mjeap.system import System, attach
+from mjeap.system import ContactParameters, System, attach
 
 G = "0 0 -0.00980665"      # standard gravity in mm / ms^2
 
@@ -149,6 +149,21 @@ def test_two_actuators_close_on_a_free_body():
     assert finger_forces[0][1] == pytest.approx(-finger_forces[1][1], rel=0.02)
     assert abs(f[-1, 1]) < 0.02 * abs(finger_forces[0][1])
     assert s.penetration() < 0.02 * 35e-6
+
+
+def test_contact_friction_lengths_are_si_and_bad_values_are_named():
+    """The torsional and rolling coefficients are lengths given in m: in a host in mm they
+    compile as mm (x 1e3); the sliding one is a ratio; impratio is passed on. Negative or
+    missing coefficients, an unknown cone and impratio < 1 are refused, named."""
+    spec = host(GRIP)
+    fingers = [attach(spec, "pedot-micro", site=n, prefix=n) for n in ("left", "right")]
+    s = System(spec, fingers, contact=ContactParameters(friction=(0.4, 2e-5, 3e-7), impratio=5.0))
+    assert list(s.model.opt.o_friction) == pytest.approx([0.4, 0.4, 2e-2, 3e-4, 3e-4])
+    assert s.model.opt.impratio == 5.0
+    for kw, name in (({"friction": (0.5, -1e-6, 0.0)}, "friction"), ({"friction": (0.5, 1e-6)}, "friction"),
+                     ({"cone": "round"}, "cone"), ({"impratio": 0.5}, "impratio")):
+        with pytest.raises(ParameterError, match=name):
+            ContactParameters(**kw)
 
 
 def test_bad_attachments_are_named():
