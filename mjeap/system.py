@@ -37,6 +37,9 @@ from .units import DEFAULT_UNITS, UnitSystem
 _PREFIX = re.compile(r"^[A-Za-z][A-Za-z0-9_-]*$")
 
 
+_CONES = {"elliptic": mujoco.mjtCone.mjCONE_ELLIPTIC, "pyramidal": mujoco.mjtCone.mjCONE_PYRAMIDAL}
+
+
 @dataclass(frozen=True)
 class ContactParameters:
     """Contact for micro-scale systems, applied to every contact of the system (MuJoCo's
@@ -71,12 +74,12 @@ class ContactParameters:
     def __post_init__(self):
         if len(self.friction) != 3 or not all(np.isfinite(f) and f >= 0 for f in self.friction):
             raise ParameterError("friction", self.friction, "(sliding >= 0, torsional >= 0 m, rolling >= 0 m)")
-        if self.cone not in ("elliptic", "pyramidal"):
-            raise ParameterError("cone", self.cone, "'elliptic' or 'pyramidal'")
+        if self.cone not in _CONES:
+            raise ParameterError("cone", self.cone, " or ".join(f"'{c}'" for c in _CONES))
         if not (np.isfinite(self.impratio) and self.impratio >= 1.0):
             raise ParameterError("impratio", self.impratio, "a ratio >= 1")
 
-    def apply(self, spec: mujoco.MjSpec, h: float, thickness: float, length: float = 1e-3) -> None:
+    def apply(self, spec: mujoco.MjSpec, h: float, thickness: float, length: float) -> None:
         """Set the host's contact override: ``h`` and ``thickness`` internal, ``length`` the
         SI size (m) of one internal length unit."""
         o = spec.option
@@ -87,7 +90,7 @@ class ContactParameters:
         o.o_margin = self.margin
         mu, torsion, rolling = self.friction[0], self.friction[1] / length, self.friction[2] / length
         o.o_friction = [mu, mu, torsion, rolling, rolling]
-        o.cone = {"elliptic": mujoco.mjtCone.mjCONE_ELLIPTIC, "pyramidal": mujoco.mjtCone.mjCONE_PYRAMIDAL}[self.cone]
+        o.cone = _CONES[self.cone]
         o.impratio = self.impratio
 
 

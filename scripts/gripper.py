@@ -24,7 +24,7 @@ bead lifts when 2 mu F >= m g at the moment the base starts to rise (at a held v
 force only grows after that).
 
 Soft-finger contact (an assumption, and why it is needed). A bent finger meets the bead
-with its face tilted by its slope theta = y'(a) (2.7 deg at the lift threshold, 4-6 deg at
+with its face tilted by its slope theta = y'(a) (3.1 deg at the lift threshold, 4-6 deg at
 2 V): the two contact normals form a V and the line through the two contacts passes
 R sin(theta) beside the bead's centre. Point contacts with Coulomb friction (MuJoCo's
 condim 3, a "hard finger") resist no moment about that line, so the bead's weight rolls it
@@ -32,22 +32,22 @@ down between the fingers with both contacts sticking, at any grip force: two har
 contacts are not force closure (grasping theory: Murray, Li & Sastry 1994, ch. 5). The
 simulation shows it (``hard_finger``: the bead stays on the table and turns about the
 gripping axis while the fingers rise past it, its contact points rolling up with them:
-(turn) R sin(theta) = 1.05 x the fingers' rise, the 5 % slip at the contacts). Held beads are held through
-contact patches, which resist that moment: MuJoCo's soft-finger contact (condim 4) with a
-torsional friction of MU_TORSION = 0.1 mm, the moment per newton of normal force of a
-patch of radius 16 mu_t / (3 pi mu) = 0.34 mm under Hertz pressure: a compliant fingertip,
-not the film's own Hertz patch (about 1 um). Holding needs mu_t >= mu R sin(theta) (18 um at
+(turn) R sin(theta) = 1.05 x the fingers' rise, the 5 % slip at the contacts). Held beads
+are held through contact patches, which resist that moment: MuJoCo's soft-finger contact
+(condim 4) with a torsional friction of MU_TORSION = 0.1 mm, the moment per newton of
+normal force of a patch of radius 16 mu_t / (3 pi mu) = 0.34 mm under Hertz pressure: a compliant fingertip,
+not the film's own Hertz patch (about 1 um). Holding needs mu_t >= mu R sin(theta) (20 um at
 the threshold, reported as measured); with 0.1 mm the moment takes 1-2 % of the elliptic
 friction cone, so the closed form's 2 mu F >= m g stays the lift condition to that.
-``impratio`` 100 cuts the soft friction's creep a hundredfold (to about 1.3 um/s under the
-bead's weight, 13 um/s with 10; ContactParameters).
+``impratio`` cuts the soft friction's creep in proportion (ContactParameters): under the
+bead's weight 13 um/s with 10, 1.3 um/s with the 100 used here (measured).
 """
 from __future__ import annotations
 
 import argparse
 import json
 from concurrent.futures import ProcessPoolExecutor
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Optional
 
@@ -66,7 +66,7 @@ A = 5e-3                      # m, bead centre from the clamps
 THICKNESS = 35e-6             # m, the finger (pedot-micro)
 MU = ContactParameters().friction[0]   # sliding friction coefficient (mjeap's default)
 MU_TORSION = 1e-4             # m, soft-finger torsional friction (assumption, see above)
-CONTACT = ContactParameters(friction=(MU, MU_TORSION, ContactParameters().friction[2]), impratio=100.0)
+CONTACT = replace(ContactParameters(), friction=(MU, MU_TORSION, ContactParameters().friction[2]), impratio=100.0)
 LIFT = 1e-3                   # m, how far the base rises
 LIFT_TIME = 0.5               # s, over which it rises (constant speed)
 LIFT_AT = 1.0                 # s, when the base starts to rise in the lift tries
@@ -111,9 +111,9 @@ def build(soft_finger: bool = True) -> System:
 @dataclass
 class GripRun:
     """One run: time (s), the left finger's grip force (N, normal to the bead, positive
-    pressing), the bead's height above its start and the base's (the slide's), the bead's x (m), the
-    contact normal's tilt from the gripping axis (rad) and the bead's spin about it
-    (rad/s); ``dropped``: the run was stopped when the bead fell behind the base."""
+    pressing), the bead's height above its start and the base's (the slide's), the bead's x
+    (m), the contact normal's tilt from the gripping axis (rad); ``dropped``: the run was
+    stopped when the bead fell behind the base."""
 
     voltage: float
     time: np.ndarray
@@ -122,7 +122,6 @@ class GripRun:
     base_rise: np.ndarray
     bead_x: np.ndarray
     tilt: np.ndarray
-    spin: np.ndarray
     penetration: float
     dropped: bool = False
     result: object = None
@@ -151,7 +150,7 @@ def grip(voltage: float, duration: float, lift_at: Optional[float] = None, sampl
     bead = m.body("bead").id
     left = set(int(b) for b in s.parts[0].link_ids)
     z0 = m.body_pos[bead][2]
-    t, force, bead_z, base_z, bead_x, tilt, spin = [], [], [], [], [], [], []
+    t, force, bead_z, base_z, bead_x, tilt = [], [], [], [], [], []
     deepest = [0.0]
 
     def on_sample(sy):
@@ -169,7 +168,6 @@ def grip(voltage: float, duration: float, lift_at: Optional[float] = None, sampl
             if m.geom_bodyid[c.geom[1]] in left or m.geom_bodyid[c.geom[0]] in left:
                 th = float(np.arctan2(abs(c.frame[0]), abs(c.frame[1])))
         tilt.append(th)
-        spin.append(float(d.cvel[bead][1]) / sy.units.time)          # about y (world), rad/s
         deepest[0] = max(deepest[0], sy.penetration())
         if stop_when_dropped and base_z[-1] - bead_z[-1] > DROPPED:
             raise _Dropped
@@ -181,7 +179,7 @@ def grip(voltage: float, duration: float, lift_at: Optional[float] = None, sampl
         dropped, r = True, None
     n = len(t)
     return GripRun(voltage, np.array(t), np.array(force), np.array(bead_z[:n]), np.array(base_z[:n]),
-                   np.array(bead_x[:n]), np.array(tilt[:n]), np.array(spin[:n]), deepest[0], dropped, r,
+                   np.array(bead_x[:n]), np.array(tilt[:n]), deepest[0], dropped, r,
                    {} if r is None else r.meta)
 
 
@@ -208,13 +206,14 @@ def closed_form_min_lift_voltage(lift_at: float = LIFT_AT) -> float:
 def min_lift_voltage(low: float, high: float, rtol: float = 0.02, hold: float = LIFT_HOLD) -> dict:
     """Bisection on the held voltage between ``low`` (must drop the bead) and ``high`` (must
     lift it) until the bracket is narrower than ``rtol`` of its top: the bracket's midpoint
-    (V) and every try."""
+    (V) and every try, with its contact tilt when the base starts to rise."""
     tries = []
 
     def lifts(v):
         r = lift_try(v, hold)
         tries.append({"voltage_v": v, "lifted": r.lifted, "bead_rise_m": float(r.bead_rise[-1]),
-                      "stopped_at_s": float(r.time[-1])})
+                      "stopped_at_s": float(r.time[-1]),
+                      "contact_tilt_at_lift_deg": float(np.degrees(r.tilt[np.searchsorted(r.time, LIFT_AT)]))})
         return r.lifted
 
     if lifts(low) or not lifts(high):
@@ -328,9 +327,10 @@ def main(argv=None):
         hard = hard_finger_check()
         held = held.result()
     v_sim = lift["voltage_v"]
-    # the torsional friction the soft-finger grasp needs at the threshold: mu R sin(theta)
-    at_threshold = grip(v_sim or v_cf, LIFT_AT + 0.05, lift_at=None)
-    theta = float(np.nanmedian(at_threshold.tilt[-3:]))
+    # the torsional friction the soft-finger grasp needs at the threshold, mu R sin(theta):
+    # theta when the base starts to rise in the lowest try that lifted (the bracket's top)
+    held_tries = [tr for tr in lift["tries"] if tr["lifted"]]
+    theta = np.radians(min(held_tries, key=lambda tr: tr["voltage_v"])["contact_tilt_at_lift_deg"]) if held_tries else np.nan
     out = {
         **{k: held[k] for k in ("grip_force_n", "grip_force_closed_form_n")},
         "min_lift_voltage_v": v_sim, "min_lift_voltage_closed_form_v": v_cf,
