@@ -23,7 +23,8 @@ __all__ = [
     "deflection_shape_tip_force", "elastica_tip_force", "Elastica", "arc_tip_moment",
     "natural_frequencies", "lateral_stiffness", "buckling_load", "arc_curvature",
     "multilayer_section", "SectionLayer", "SectionProperties", "lateral_stiffness_column",
-    "critical_tip_load", "postbuckled_column",
+    "critical_tip_load", "postbuckled_column", "bimorph_stiffness_per_width", "bimorph_geometry_factor",
+    "bimorph_free_deflection", "bimorph_blocked_force", "bimorph_motional_current",
 ]
 
 
@@ -411,3 +412,60 @@ def first_frequency_variable(L: float, EI, mass_per_length, guess: float, tip_ma
     if not sol.success:
         raise RuntimeError(f"eigenvalue BVP did not converge: {sol.message}")
     return float(np.sqrt(sol.p[0] * EI0 / (m0 * L**4)) / (2 * np.pi))
+
+
+# ------------------------------------------- PZT bimorph closed forms (seed 003's actuators)
+# Transcribed, with the published variables, from Jafferis et al. 2015 (Smart Mater. Struct. 24
+# 065023) as Harvard's own HAMR actuator model implements them (HarvardAgileRoboticsLab/drake,
+# examples/HAMR-URDF/dev/Actuator/PZTBender2.m: ``df``, ``GF``, ``Ft``/``Fb``), and seed 003's
+# eq. (13). Independent of mjeap's drive and section code: they are the checks of those.
+#
+# V is the closed form's voltage, the difference of the two plates' voltages: PZTBender2 sets
+# the field eps = (V_b - V_g) / t_p at full drive, and its force is Ft - Fb with the plates at
+# V_b - V_sig and V_sig - V_g. Under unipolar simultaneous drive (V_g = 0) that is
+# V = |2 V_sig - V_bias|, i.e. V_bias at full drive.
+
+def bimorph_stiffness_per_width(E_p: float, t_p: float, E_cf: float, t_cf: float) -> float:
+    """Bending stiffness per width of a symmetric PZT / carbon-fibre / PZT bimorph (N m):
+    D = (1/3) E_p t_p (1.5 t_cf^2 + 3 t_cf t_p + 2 t_p^2) + E_cf t_cf^3 / 12 (Jafferis 2015;
+    PZTBender2's ``df_den``)."""
+    return (E_p * t_p * (1.5 * t_cf**2 + 3 * t_cf * t_p + 2 * t_p**2) / 3 + E_cf * t_cf**3 / 12)
+
+
+def bimorph_geometry_factor(width_ratio: float, length_ratio: float) -> float:
+    """Blocked-force geometry factor G_F of the trapezoidal bimorph with a rigid extension
+    (Jafferis 2015; PZTBender2's ``GF``): width_ratio w_r = base width / nominal width (the
+    nominal width w_n is the mean of base and tip, so the tip is (2 - w_r) w_n), length_ratio
+    l_r = extension length / active length. G_F = 1 for a rectangle without extension."""
+    wr, lr = float(width_ratio), float(length_ratio)
+    if not 0.0 < wr < 2.0:
+        raise ParameterError("width_ratio", wr, "0 < w_r < 2 (base width / mean width)")
+    if abs(wr - 1.0) < 1e-3:
+        # near a rectangle the closed form cancels (0/0): its limit, within 0.05 % here
+        return (1 + 2 * lr) / ((1 + lr) ** 3 - lr**3)
+    num = 8 * (1 - wr) ** 3 * (1 + 2 * lr)
+    den = (-6 * (wr - 1) * (-3 + 4 * lr * (wr - 1) + 2 * wr)
+           + 3 * (-2 + 2 * lr * (wr - 1) + wr) ** 2 * np.log((2 - wr) / wr))
+    return num / den
+
+
+def bimorph_free_deflection(f31: float, V: float, t_p: float, t_cf: float, L: float, length_ratio: float,
+                            D: float) -> float:
+    """Free deflection (m) at the end of the rigid extension: (1/4)(1 + 2 l_r) f31 V
+    (t_p + t_cf) L^2 / D (Jafferis 2015; PZTBender2's ``df``), f31 the effective stress per
+    field (Pa m/V), V the difference of the plates' voltages (V_bias at full drive)."""
+    return 0.25 * (1 + 2 * length_ratio) * f31 * V * (t_p + t_cf) * L**2 / D
+
+
+def bimorph_blocked_force(f31: float, V: float, t_p: float, t_cf: float, L: float, nominal_width: float,
+                          width_ratio: float, length_ratio: float) -> float:
+    """Blocked force (N) at the end of the rigid extension: (3/4)(w_n / L) f31 (t_p + t_cf) V
+    G_F (Jafferis 2015; PZTBender2's ``Ft - Fb``), w_n the nominal (mean) width."""
+    return 0.75 * nominal_width / L * f31 * (t_p + t_cf) * V * bimorph_geometry_factor(width_ratio, length_ratio)
+
+
+def bimorph_motional_current(f31: float, area: float, strain_rate):
+    """Seed 003 eq. (13): the motional current of a free bimorph, I = 2 A f31 d(eps_1)/dt (A),
+    A the electrode area of one plate (m^2), eps_1 the bending strain of one plate (its
+    mean over the plate; the two plates' strains are opposite and their currents add)."""
+    return 2.0 * area * f31 * np.asarray(strain_rate)

@@ -1,20 +1,32 @@
 """PZT-5H bending bimorph under unipolar simultaneous drive (Jayaram 2018, seed 003).
 
-A constant bias V_bias sits across the outer electrodes and the drive signal
-V_sig in [0, V_bias] on the centre layer, so the two plates see V_sig and V_bias - V_sig
-and the bending follows V_eff = V_sig - V_bias / 2. Moment (Wood et al. 2005,
-Jafferis et al. 2015): at a section of width w,
+A constant bias V_bias sits across the outer electrodes and the drive signal V_sig in
+[0, V_bias] on the centre layer, so the two plates see V_bias - V_sig and V_sig, and the
+bending follows V_eff = V_sig - V_bias / 2.
 
-    M = (1/2) f31 w (t_p + t_cf) V_eff,
+Moment per volt, derived three ways (they agree; the factor was 1/2 before issue 22):
 
-so the curvature M / (D w) is uniform even on the trapezoidal planform; with a rigid tip
-block of length l_ext the free deflection at its end is (1/4)(1 + 2 l_ext/L) f31 V
-(t_p + t_cf) L^2 / D.
+1. Plate forces (Wood et al. 2005, Jafferis et al. 2015): a plate at voltage V_i carries the
+   effective stress f31 V_i / t_p, a force per width f31 V_i, at (t_p + t_cf) / 2 from the
+   symmetric bimorph's mid-plane. The plates bend oppositely, so at a section of width w
 
-Actuator current, eq. (1): I = (2 V_sig - V_bias) / (2 R) + C dV_sig/dt + I_mech. The
-motional current is the reciprocal of the moment: I_mech = sum_j Gamma_j dtheta_j/dt with
-Gamma_j = dM_j/dV_sig the transduction coefficient (N m/V) at hinge j, so the
-electromechanical energy balance holds exactly; the seed writes it as K(V_bias) v.
+       M = f31 w (t_p + t_cf) (V_sig - (V_bias - V_sig)) / 2 = f31 w (t_p + t_cf) V_eff.
+
+   Harvard's HAMR actuator model (PZTBender2.m) writes the same as forces Ft - Fb that are
+   proportional to the plates' voltage difference V = 2 V_sig - V_bias, which is the V of
+   the closed forms in ``mjeap.analytical`` (V_bias at full drive).
+2. Seed 003 eq. (13): I_mech = 2 A f31 d(eps_1)/dt, eps_1 the bending strain of one plate,
+   kappa (t_p + t_cf) / 2 at its mid-plane. Over a hinge j of width w_j and rotation theta_j
+   (A eps_1 summed as w_j l_j kappa_j (t_p + t_cf)/2 = w_j theta_j (t_p + t_cf) / 2):
+   I_mech = sum_j Gamma_j dtheta_j/dt with Gamma_j = f31 w_j (t_p + t_cf).
+3. Reciprocity: the motional current's coefficient is dM_j/dV_sig (the electromechanical
+   energy balance; ``tests/test_piezo_moment.py`` checks it over a driven cycle).
+
+So Gamma_j = f31 w_j (t_p + t_cf) N m/V per hinge and M_j = Gamma_j V_eff: the curvature
+M / (D w) = f31 (t_p + t_cf) V_eff / D is uniform even on the trapezoidal planform.
+
+Actuator current, eq. (1): I = (2 V_sig - V_bias) / (2 R) + C dV_sig/dt + I_mech, with
+I_mech = sum_j Gamma_j dtheta_j/dt (the seed writes it as K(V_bias) v).
 """
 from __future__ import annotations
 
@@ -23,6 +35,7 @@ from typing import Dict
 import mujoco
 import numpy as np
 
+from .. import analytical as an
 from .base import Drive, register_drive
 
 _J = "Jafferis et al. 2015: f31 ~ 32 Pa m/V free (24 blocked)"
@@ -55,7 +68,7 @@ class PiezoBimorphDrive(Drive):
         self.t_p = act.layers[names.index("pzt-top")].thickness
         self.t_cf = act.layers[names.index("carbon-fibre")].thickness
         w = scene.layout.hinge_width
-        self.gamma = 0.5 * self.params["f31"] * w * (self.t_p + self.t_cf)   # N m / V per hinge
+        self.gamma = self.params["f31"] * w * (self.t_p + self.t_cf)   # N m / V per hinge (module text)
         self._v_prev = None
         self._v = self._dv = 0.0
         self._m = np.zeros(scene.layout.segments)
@@ -122,32 +135,30 @@ class PiezoBimorphDrive(Drive):
                 "current_capacitive (A)": i_c, "current_motional (A)": i_m,
                 "drive_moment_root (N m)": float(self._m[0])}
 
-    # ---- Wood / Jafferis formulas -------------------------------------------------
+    # ---- Wood / Jafferis closed forms (mjeap.analytical), at this drive's V_eff -------------
     def bending_stiffness_per_width(self) -> float:
         sec = self.scene.actuator.section_at(0.0)
         return sec.flexural_rigidity / float(self.scene.actuator.width_at(0.0))
 
+    def _closed_form_geometry(self):
+        p = self.scene.actuator.planform
+        wn = 0.5 * (p.base_width + p.tip_width)
+        return p.length, wn, p.base_width / wn, p.extension_length / p.length
+
     def free_deflection(self, v_eff: float) -> float:
-        """(1/4)(1 + 2 l_r) f31 V (t_p + t_cf) L^2 / D (m)."""
-        act = self.scene.actuator
-        L = act.length
-        lr = act.planform.extension_length / L
-        return 0.25 * (1 + 2 * lr) * self.params["f31"] * v_eff * (self.t_p + self.t_cf) * L**2 / \
-            self.bending_stiffness_per_width()
+        """Free deflection (m) at the tip block's end for V_eff = V_sig - V_bias/2 (V): the
+        Wood/Jafferis closed form with its plate-voltage difference V = 2 V_eff."""
+        L, _, _, lr = self._closed_form_geometry()
+        return an.bimorph_free_deflection(self.params["f31"], 2.0 * v_eff, self.t_p, self.t_cf, L, lr,
+                                          self.bending_stiffness_per_width())
 
     def blocked_force(self, v_eff: float) -> float:
-        """(3/4)(w_n/L) f31 (t_p + t_cf) V G_F (N) at the end of the rigid tip block, w_n the
-        base width and G_F = (1 + 2 l_r) (L^3 / (3 w_n)) / int_0^L (L (1 + l_r) - x)^2 / w(x) dx
-        the geometry factor of the trapezoid with its extension (Wood/Jafferis; the ratio of
-        the free deflection to the tip compliance, evaluated with scipy quad)."""
-        from scipy.integrate import quad
-        act = self.scene.actuator
-        L, wn = act.length, act.planform.base_width
-        lr = act.planform.extension_length / L
-        GF = (1 + 2 * lr) * (L**3 / (3 * wn)) / quad(lambda x: (L * (1 + lr) - x) ** 2 / float(act.width_at(x)), 0, L)[0]
-        return 0.75 * wn / L * self.params["f31"] * (self.t_p + self.t_cf) * v_eff * GF
+        """Blocked force (N) at the tip block's end for V_eff (V): the Wood/Jafferis closed
+        form with V = 2 V_eff and the trapezoid's geometry factor G_F."""
+        L, wn, wr, lr = self._closed_form_geometry()
+        return an.bimorph_blocked_force(self.params["f31"], 2.0 * v_eff, self.t_p, self.t_cf, L, wn, wr, lr)
 
     def reference_curvature(self, t, v, initial_curvature=0.0):
         """Quasi-static uniform curvature of the free bimorph, M / (D w)."""
-        return 0.5 * self.params["f31"] * (self.t_p + self.t_cf) * (np.asarray(v) - 0.5 * self.params["bias"]) / \
+        return self.params["f31"] * (self.t_p + self.t_cf) * (np.asarray(v) - 0.5 * self.params["bias"]) / \
             self.bending_stiffness_per_width()
