@@ -3,7 +3,11 @@ report's figures and the recording) and an experiment (checks + curves + notes).
 
 A check with a tolerance passes or fails; a check without one is a comparison that is
 reported with its explanation (for example a published measurement the model is not expected
-to reproduce). References are never computed from the simulator itself.
+to reproduce). References are never computed from the simulator itself, and a toleranced
+check names the kind of its reference (:data:`REFERENCE_KINDS`): a number printed in a
+source, a formula transcribed from a source (with its equation), or a solution by a different
+method. A reference that restates the code's own derivation is no check (issue 22): such a
+row may be shown, as 'compare', never passed.
 """
 from __future__ import annotations
 
@@ -11,6 +15,13 @@ from dataclasses import asdict, dataclass, field
 from typing import Callable, Dict, List, Optional
 
 import numpy as np
+
+
+#: kinds of reference a toleranced check may have, as the report prints them
+PUBLISHED_NUMBER = "published number"
+PUBLISHED_FORMULA = "published formula"
+INDEPENDENT_SOLUTION = "independent solution"
+REFERENCE_KINDS = (PUBLISHED_NUMBER, PUBLISHED_FORMULA, INDEPENDENT_SOLUTION)
 
 
 @dataclass
@@ -27,6 +38,7 @@ class Check:
     error_kind: str = "relative"
     note: str = ""
     experiment: str = ""
+    kind: str = ""                    # one of REFERENCE_KINDS ('' for a compare row without one)
 
     @property
     def error(self) -> float:
@@ -84,6 +96,11 @@ class Experiment:
     seconds: float = 0.0
 
     def check(self, quantity, unit, simulated, reference, source, tolerance=None, **kw) -> Check:
+        """Add a row; a row with a ``tolerance`` must say ``kind=`` (one of REFERENCE_KINDS)."""
+        kind = kw.get("kind", "")
+        if (tolerance is not None or kind) and kind not in REFERENCE_KINDS:
+            raise ValueError(f"check {quantity!r} of {self.name}: kind={kind!r}; a toleranced check names its "
+                             f"reference's kind, one of {', '.join(REFERENCE_KINDS)}")
         c = Check(quantity, unit, float(simulated), float(reference), source, tolerance,
                   experiment=self.name, **kw)
         self.checks.append(c)

@@ -10,11 +10,11 @@ from typing import Optional, List
 
 import numpy as np
 
-from .core import Experiment
+from .core import REFERENCE_KINDS, Experiment
 
 #: beam frames per simulated run in an experiment's recording
 MAX_BEAM_FRAMES = 300
-COLUMNS = ("experiment", "quantity", "simulated", "reference", "source", "error", "tolerance", "verdict")
+COLUMNS = ("experiment", "quantity", "simulated", "reference", "kind", "source", "error", "tolerance", "verdict")
 
 
 def _fmt(x: float) -> str:
@@ -34,8 +34,8 @@ def _tol(c) -> str:
 
 
 def rows(experiments: List[Experiment]) -> List[List[str]]:
-    return [[c.experiment, c.quantity, f"{_fmt(c.simulated)} {c.unit}", f"{_fmt(c.reference)} {c.unit}", c.source,
-             _err(c), _tol(c), c.verdict] for ex in experiments for c in ex.checks]
+    return [[c.experiment, c.quantity, f"{_fmt(c.simulated)} {c.unit}", f"{_fmt(c.reference)} {c.unit}",
+             c.kind or "-", c.source, _err(c), _tol(c), c.verdict] for ex in experiments for c in ex.checks]
 
 
 def console_table(experiments: List[Experiment], width: int = 60) -> str:
@@ -170,10 +170,12 @@ def _unit_of(ex: Experiment, panel: str) -> str:
 def markdown_section(ex: Experiment, figures: bool = True) -> str:
     out = [f"## {ex.title}", "", f"`{ex.name}` ({ex.seconds:.1f} s)", ""]
     # the verdict first and the (long) source last: a narrow view shows what matters
-    out += ["| verdict | quantity | simulated | reference | error | tolerance | source |", "|---|---|---|---|---|---|---|"]
+    out += ["| verdict | quantity | simulated | reference | error | tolerance | reference kind | source |",
+            "|---|---|---|---|---|---|---|---|"]
     for r in rows([ex]):
-        quantity, sim, ref, src, err, tol, verdict = r[1:]
-        out.append("| " + " | ".join(x.replace("|", "/") for x in (verdict, quantity, sim, ref, err, tol, src)) + " |")
+        quantity, sim, ref, kind, src, err, tol, verdict = r[1:]
+        out.append("| " + " | ".join(x.replace("|", "/") for x in (verdict, quantity, sim, ref, err, tol, kind, src))
+                   + " |")
     if ex.notes:
         out += [""] + [f"- {n}" for n in ex.notes]
     if figures and ex.curves:
@@ -185,10 +187,17 @@ def write_markdown(experiments: List[Experiment], path: Path, figures: bool) -> 
     n = sum(len(e.checks) for e in experiments)
     failed = [c for e in experiments for c in e.checks if c.verdict == "FAIL"]
     toleranced = sum(c.tolerance is not None for e in experiments for c in e.checks)
+    kinds = {k: sum(c.tolerance is not None and c.kind == k for e in experiments for c in e.checks)
+             for k in REFERENCE_KINDS}
     head = ["# mjeap validation report", "",
             f"{n} rows, {toleranced} with a tolerance, {len(failed)} failed. "
             "'compare' rows set the simulation beside a published number or a model it is not "
-            "expected to match within a tolerance; their notes say why they differ.", ""]
+            "expected to match within a tolerance; their notes say why they differ.", "",
+            "Every toleranced row is against a reference independent of the code: "
+            + ", ".join(f"{v} against a {k}" for k, v in kinds.items())
+            + " (a published formula is transcribed with its equation; an independent solution is computed by a "
+            "different method: a BVP, quadrature, scipy's integrators, a published model's own equations). "
+            "'compare' rows include checks of a quantity against the number it was fitted to.", ""]
     if not figures:
         head += ["(Figures need matplotlib: `pip install -e '.[report]'`.)", ""]
     path.write_text("\n".join(head) + "\n" + "\n".join(markdown_section(e, figures) for e in experiments))
