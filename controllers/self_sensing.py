@@ -130,6 +130,7 @@ def calibrate_on_free_actuator(actuator, bias: float, frequencies, **scene_kw) -
 
 def quasi_static_alpha(length: float, extension: float, area: float, f31: float, t_p: float, t_cf: float) -> float:
     """alpha (m/(A s)) of the uniform-curvature bimorph: the tip velocity (L/2 + l_ext) L kappa'
-    over the motional current (1/2) f31 (t_p + t_cf) A kappa' (the Wood/Jafferis moment per
-    width integrated over the PZT area A); the counterpart of the paper's eq. (17b)."""
-    return length * (0.5 * length + extension) / (0.5 * f31 * (t_p + t_cf) * area)
+    over the motional current of seed 003's eq. (13), 2 A f31 eps_1' with the plate's mid-plane
+    strain eps_1 = kappa (t_p + t_cf)/2 over the PZT area A; the counterpart of the paper's
+    eq. (17b), which averages 1/y over the plate instead and leaves out the tip block."""
+    return length * (0.5 * length + extension) / (f31 * (t_p + t_cf) * area)

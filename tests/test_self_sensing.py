@@ -37,35 +37,43 @@ def test_eq8_recovers_the_blocking_factor(scene, sweeps, c_scale):
     """With C_fit = c_scale x the free capacitance (2: the datasheet's 16 nF against the fixed
     actuator's ~8 nF, seed 003), eq. (8) must return beta = 1 / c_scale, as closely as its
     one-velocity-scale assumption allows: the simulated |v / I_mech| is not one number but
-    rises from the uniform arc's 541 to 606 m/(A s) at 2 kHz (the tip block makes the first
-    mode's curvature peak at the root), and the fit may be off by half that spread (6 %;
-    measured 2.6 %). The same beta for both capacitances to 1e-4: the fit sees only beta C."""
+    rises from the uniform arc's 270 to 303 m/(A s) at 2 kHz (the tip block makes the first
+    mode's curvature peak at the root). The fit trades that mismatch of the motional current
+    against beta's dielectric current: a relative mismatch delta of I_mech = C_m dV/dt moves
+    beta by about delta C_m / C, so the bound is the spread times C_m / C (measured: 10.6 %
+    within 15 %; with the halved moment of 8290cc9, C_m / C was 4x smaller and beta within
+    2.6 %). The same beta for both capacitances to 1e-4: the fit sees only beta C."""
     sw = sweeps[60.0]
     est = calibrate(sw, 60.0, R_FIT, c_scale * capacitance(scene))
     r = np.abs(sw.response("tip_velocity") / sw.response("current_motional (A)"))
-    assert est.beta * c_scale == pytest.approx(1.0, abs=0.5 * (r.max() / r.min() - 1))
+    cm_over_c = np.abs(sw.response("current_motional (A)")[0] / sw.response("current_capacitive (A)")[0])
+    assert est.beta * c_scale == pytest.approx(1.0, abs=(r.max() / r.min() - 1) * cm_over_c)
     assert r.max() / r.min() - 1 < 0.2
     one = calibrate(sw, 60.0, R_FIT, capacitance(scene))
     assert est.beta * c_scale == pytest.approx(one.beta, rel=1e-4)
 
 
-def test_velocity_scale_matches_the_uniform_curvature_beam(scene, sweeps):
-    """Well below resonance the beam bends as a uniform arc, so v / I_mech is the closed form
-    (L/2 + l_ext) L / ((1/2) f31 (t_p + t_cf) A), 0.5 %; the fitted alpha (all frequencies, a
-    geometric mean) lies within the sweep's range of |v / I_mech| (541-606 m/(A s)), which
-    the paper's eq. (17b) range for Type II, 450-650 m/(A s), contains."""
+def test_velocity_scale_matches_eq_13_and_eq_17b(scene, sweeps):
+    """Well below resonance the beam bends as a uniform arc: v = (L/2 + l_ext) L dkappa/dt at
+    the tip block's end and eq. (13) gives I_mech = 2 A f31 (t_p + t_cf)/2 dkappa/dt (the plate's
+    mid-plane strain), so v / I_mech = (L/2 + l_ext) L / (f31 (t_p + t_cf) A): 0.5 %. The
+    paper's own eq. (17b), L^2 int dy/y / (4 A f31 t_p) (it averages 1/y over the plate and
+    leaves out the tip block), with the same f31 lies inside the sweep's range of |v / I_mech|
+    (270-303 m/(A s)); the fitted alpha (all frequencies, a geometric mean) too. The paper's
+    450-650 m/(A s) at 20-100 V bias come from its f31(V_bias), below the catalog's free
+    32 Pa m/V at these low fields (eq. 17b at 450-650 needs 14-20 Pa m/V)."""
     sc, sw = scene, sweeps[60.0]
     act, drv = sc.actuator, make_drive("piezo-bimorph", sc)
     x = np.linspace(0.0, act.length, 201)
     area = np.trapezoid(act.width_at(x), x)           # trapezoid: exact for the linear taper
     a_qs = quasi_static_alpha(act.length, act.planform.extension_length, area,
                               drv.params["f31"], drv.t_p, drv.t_cf)
-    low = np.abs(sw.response("tip_velocity") / sw.response("current_motional (A)"))[0]
-    assert low == pytest.approx(a_qs, rel=0.005)
-    est = calibrate(sw, 60.0, R_FIT, capacitance(sc))
     r = np.abs(sw.response("tip_velocity") / sw.response("current_motional (A)"))
+    assert r[0] == pytest.approx(a_qs, rel=0.005)
+    a_17b = act.length**2 * np.log((2 * drv.t_p + drv.t_cf) / drv.t_cf) / (4 * area * drv.params["f31"] * drv.t_p)
+    assert r.min() <= a_17b <= r.max()
+    est = calibrate(sw, 60.0, R_FIT, capacitance(sc))
     assert r.min() <= est.alpha <= r.max()
-    assert 450 < r.min() and r.max() < 650
 
 
 def test_estimate_within_the_papers_accuracy_at_every_bias(scene, sweeps):
@@ -80,11 +88,14 @@ def test_estimate_within_the_papers_accuracy_at_every_bias(scene, sweeps):
 
 def test_without_the_blocking_factor_the_estimate_fails(scene, sweeps):
     """The same check must fail with the datasheet capacitance taken as is (beta = 1): the
-    dielectric current left over swamps the motional one below resonance."""
+    dielectric current left over, C dV/dt beside the motional C_m dV/dt (C_m / C = 1.26), is
+    in phase with it below resonance, so it shows in the magnitude (78 %) more than in the
+    phase (6 deg)."""
     good = calibrate(sweeps[60.0], 60.0, R_FIT, 2.0 * capacitance(scene))
     raw = SelfSensingEstimator(60.0, R_FIT, 2.0 * capacitance(scene), beta=1.0, alpha=good.alpha)
     mag, ph = raw.errors(sweeps[60.0])
-    assert np.abs(mag).max() > MAG_TOL and np.abs(ph).max() > PHASE_TOL
+    assert np.abs(mag).max() > MAG_TOL or np.abs(ph).max() > PHASE_TOL
+    assert np.abs(mag).max() > 5 * MAG_TOL
 
 
 def test_noise_on_the_current_grows_the_error_linearly(scene):
