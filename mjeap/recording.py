@@ -18,7 +18,7 @@ Entity paths (SI: metres, seconds, volts):
   parameters with their sources (static, in the layout)
 
 Timeline ``time`` is simulated time; the viewer opens paused. Deformation scale: where the
-largest deflection is below 1 % of L (piezo bimorphs: +-36 um on 9.2 mm), the 3D view
+largest deflection is below 1 % of L (piezo bimorphs: +-72 um on 9.2 mm), the 3D view
 shows the deflection magnified (x 2, 5, 10, ...) and says so in its title, as finite-element
 post-processors do; the time series are always true values.
 """
