@@ -8,6 +8,7 @@ from scipy import signal
 from mjeap import analytical as an
 from mjeap.cli import main
 from mjeap.validation import REGISTRY, Experiment, run_validation
+from mjeap.validation.core import PUBLISHED_NUMBER, REFERENCE_KINDS
 
 EQ8 = signal.TransferFunction([63.0, 63.0 * 0.52], np.polymul([1, 0.3], [1, 1.8]))
 
@@ -75,6 +76,7 @@ def test_run_validation_writes_report_json_figures_and_recordings(tmp_path):
     doc = json.loads((tmp_path / "validation.json").read_text())
     assert doc["passed"] and [e["name"] for e in doc["experiments"]] == ["mechanics-section", "mutlu2013-identify"]
     assert all(c["source"] for e in doc["experiments"] for c in e["checks"])
+    assert all(c["kind"] in REFERENCE_KINDS for e in doc["experiments"] for c in e["checks"] if c["tolerance"] is not None)
     md = (tmp_path / "report.md").read_text()
     assert "joint stiffness k" in md
     for e in exps:
@@ -97,7 +99,7 @@ def test_report_links_a_figure_for_every_experiment_with_curves(tmp_path):
 def test_validate_exits_nonzero_when_a_toleranced_check_fails(tmp_path, capsys):
     def broken(quick=False):
         ex = Experiment("zz-broken", "a check that must fail")
-        ex.check("answer", "-", 41.0, 42.0, "Adams 1979", tolerance=0.01)
+        ex.check("answer", "-", 41.0, 42.0, "Adams 1979", tolerance=0.01, kind=PUBLISHED_NUMBER)
         ex.check("comparison only", "-", 1.0, 2.0, "a paper")
         return ex
     REGISTRY["zz-broken"] = broken
@@ -107,6 +109,19 @@ def test_validate_exits_nonzero_when_a_toleranced_check_fails(tmp_path, capsys):
         assert "FAIL zz-broken: answer" in out and "1 fail" in out
     finally:
         del REGISTRY["zz-broken"]
+
+
+def test_a_toleranced_check_names_its_reference_kind():
+    """Issue 22: a row with a tolerance says what its reference is (a published number, a
+    published formula or an independent solution); without it, or with another word, the
+    row is refused. A comparison row needs none."""
+    ex = Experiment("zz-kinds", "kinds")
+    with pytest.raises(ValueError, match="kind"):
+        ex.check("answer", "-", 41.0, 42.0, "Adams 1979", tolerance=0.01)
+    with pytest.raises(ValueError, match="kind"):
+        ex.check("answer", "-", 41.0, 42.0, "Adams 1979", tolerance=0.01, kind="restated derivation")
+    assert ex.check("answer", "-", 41.0, 42.0, "Adams 1979", tolerance=0.01, kind=PUBLISHED_NUMBER).kind == PUBLISHED_NUMBER
+    assert ex.check("comparison only", "-", 1.0, 2.0, "a paper").verdict == "compare"
 
 
 def test_unknown_experiment_is_named(capsys):

@@ -1,8 +1,11 @@
 """Seed 000 (Dadras et al. 2021): the PEDOT:PSS/PEO micro trilayer, unloaded and loaded.
 
-References: the paper's fitted step response (eq. 7), its transfer function (eq. 8, via
-scipy.signal.lsim), its piecewise-linear loaded model (Table I, :class:`mjeap.analytical.DadrasModel`),
-its stability statement, and the column buckling loads of :mod:`mjeap.analytical`.
+References: the paper's fitted step response (eq. 7) and transfer function (eq. 8, via
+scipy.signal.lsim) as published formulas; its piecewise-linear loaded model (Table I with eqs. 6
+and 8, transcribed in :class:`mjeap.analytical.DadrasModel`) as a published formula with the
+paper's own model-vs-measurement error as tolerance; the relaxed column load (a characteristic
+equation solved by brentq, :func:`mjeap.analytical.critical_load_with_arm`) as an independent
+solution; its stability statement and the other column loads as comparisons.
 """
 from __future__ import annotations
 
@@ -14,7 +17,7 @@ from ..discretize import Payload, clamp_rotation
 from ..errors import DivergenceError
 from ..rollout import rollout
 from ..scene import Scene
-from .core import Experiment, experiment
+from .core import INDEPENDENT_SOLUTION, PUBLISHED_FORMULA, Experiment, experiment
 
 UP = clamp_rotation("up")
 EQ8 = signal.TransferFunction([63.0, 63.0 * 0.52], np.polymul([1, 0.3], [1, 1.8]))
@@ -39,10 +42,12 @@ def unloaded(quick: bool = False) -> Experiment:
     ref7 = 181 - 90 * np.exp(-1.8 * r.time) - 265 * np.exp(-0.3 * r.time)
     swing = np.ptp(ref7)
     rms = np.sqrt(np.mean((r.tip_curvature - ref7) ** 2))
-    ex.check("3 V step from -174 1/m: RMS deviation / swing", "-", rms / swing, 0.0, f"{PAPER} eq. (7)",
-             tolerance=0.02, error_kind="absolute",
+    eq7 = f"{PAPER} eq. (7): the paper's fit to its measured 3 V step, kappa(0-) = -174 1/m"
+    ex.check("3 V step from -174 1/m: RMS deviation / swing", "-", rms / swing, 0.0, eq7,
+             tolerance=0.02, error_kind="absolute", kind=PUBLISHED_FORMULA,
              note="the paper's own fit is rounded to 3 digits (0.2 % of the swing)")
-    ex.check("3 V step: curvature at 15 s", "1/m", r.tip_curvature[-1], ref7[-1], f"{PAPER} eq. (7)", tolerance=0.02)
+    ex.check("3 V step: curvature at 15 s", "1/m", r.tip_curvature[-1], ref7[-1], eq7, tolerance=0.02,
+             kind=PUBLISHED_FORMULA)
     ex.curve("3 V step", "mjeap (hinge chain + rc-relaxation)", r.time, r.tip_curvature, "time (s)", KAPPA)
     ex.curve("3 V step", f"{PAPER} eq. (7)", r.time, ref7, "time (s)", KAPPA, "--")
     ex.rollouts.append(("step 3 V", r, None))
@@ -50,8 +55,9 @@ def unloaded(quick: bool = False) -> Experiment:
         r = rollout(Scene("pedot-micro"), f"square:{vpp / 2}V@0.1Hz", 20.0, progress=False)
         _, ref, _ = signal.lsim(EQ8, r.voltage, r.time)
         ex.check(f"{vpp:g} Vpp 0.1 Hz square: peak-to-peak, second period", "1/m",
-                 _late_p2p(r.time, r.tip_curvature), _late_p2p(r.time, ref), f"{PAPER} eq. (8), scipy lsim",
-                 tolerance=0.02)
+                 _late_p2p(r.time, r.tip_curvature), _late_p2p(r.time, ref),
+                 f"{PAPER} eq. (8), K/V = 63 (s + 0.52) / ((s + 0.3)(s + 1.8)), by scipy lsim",
+                 tolerance=0.02, kind=PUBLISHED_FORMULA)
         ex.curve(f"{vpp:g} Vpp square", "mjeap", r.time, r.tip_curvature, "time (s)", KAPPA)
         ex.curve(f"{vpp:g} Vpp square", f"{PAPER} eq. (8)", r.time, ref, "time (s)", KAPPA, "--")
         ex.rollouts.append((f"square {vpp:g} Vpp", r, None))
@@ -74,8 +80,9 @@ def payloads(quick: bool = False) -> Experiment:
             sim, ref = _late_p2p(r.time, r.tip_curvature), _late_p2p(r.time, kap_model)
             label = f"{m * 1e6:.2f} mg, {vpp:g} Vpp"
             ex.check(f"{label}: peak-to-peak, second period", "1/m", sim, ref,
-                     f"{PAPER} Table I piecewise-linear closed-loop model (regions {sorted(set(regions))})",
-                     tolerance=0.15,
+                     f"{PAPER} Table I with eqs. (6) and (8): the paper's piecewise-linear closed-loop model "
+                     f"(transcribed in mjeap.analytical.DadrasModel; regions {sorted(set(regions))})",
+                     tolerance=0.15, kind=PUBLISHED_FORMULA,
                      note="tolerance = the paper's reported model-vs-measurement error (< 15 %)")
             ex.check(f"{label}: peak-to-peak vs unloaded", "1/m", sim, unl[vpp],
                      f"{PAPER} eq. (8), unloaded (lsim)",
@@ -151,7 +158,10 @@ def stability(quick: bool = False) -> Experiment:
                  abs(r.tip_curvature[-1]) / 5.0, 1.0, "relaxed column load (EI x 0.3/0.52, payload on a rigid arm)",
                  note="above 1: the kick grew (buckled); below 1: it decayed (stable)")
         ex.check(f"{factor:g} x relaxed buckling load: buckled as the relaxed column predicts", "-",
-                 float(grew), float(should_buckle), "relaxed column load", tolerance=0.0, error_kind="absolute")
+                 float(grew), float(should_buckle),
+                 "relaxed column load: k a tan(kL) = 1 for the payload on a rigid arm a = l_e - L (brentq, "
+                 "mjeap.analytical.critical_load_with_arm), EI x 0.3/0.52 = the DC stiffness of eq. (8)'s "
+                 "mechanical block", tolerance=0.0, error_kind="absolute", kind=INDEPENDENT_SOLUTION)
         ex.rollouts.append((f"{factor:g} x relaxed load at 0 V", r, sc.rotation))
         ex.curve("sustained load at 0 V", f"mjeap, {factor:g} x relaxed column load", r.time, r.tip_curvature,
                  "time (s)", KAPPA)

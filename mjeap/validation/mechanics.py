@@ -1,5 +1,7 @@
-"""Beam mechanics of the simulated chain and cable against closed forms: the elastica, the
-exact arc, natural frequencies with tip mass, column buckling and the multilayer section."""
+"""Beam mechanics of the simulated chain and cable against solutions by other methods (the
+elastica by scipy solve_bvp, the exact arc, the characteristic equation of the cantilever with
+tip mass, column buckling by shooting and by elliptic integrals) and the multilayer section
+against the thesis's printed results."""
 from __future__ import annotations
 
 import numpy as np
@@ -8,7 +10,7 @@ from .. import analytical as an
 from ..discretize import Payload
 from ..scene import Scene
 from ..section import multilayer_section  # noqa: F401  (documented reference)
-from .core import Experiment, experiment
+from .core import INDEPENDENT_SOLUTION, PUBLISHED_FORMULA, PUBLISHED_NUMBER, Experiment, experiment
 
 ACT = "pedot-micro"
 L, EI, M_BEAM = 6e-3, 1 / 4.86e7, 0.695e-6
@@ -60,13 +62,14 @@ def elastica(quick: bool = False) -> Experiment:
                 ex.beam(f"{rep}: settled under P L^2/EI = 3", sc)
             if a in (0.05, 1.0, 3.0):
                 ex.check(f"{rep}: tip deflection, P L^2/EI = {a:g}", "m", tip[1], ref.tip[1],
-                         "elastica (scipy solve_bvp)", tolerance=0.01)
+                         "elastica (scipy solve_bvp)", tolerance=0.01, kind=INDEPENDENT_SOLUTION)
         ex.curve("tip force", f"mjeap {rep}", loads, np.array(ys) / L, "P L^2 / EI (-)", "tip deflection / L (-)", "o")
         for kl in (0.3, 2.0):
             M = kl * EI / L
             settled(sc, moment=M)
             ex.check(f"{rep}: tip-couple arc curvature, kappa L = {kl:g}", "1/m", sc.tip_curvature(), kl / L,
-                     "exact arc kappa = M / EI", tolerance=0.005)
+                     "exact continuum solution: a tip couple bends the elastica into a circular arc, kappa = M / EI",
+                     tolerance=0.005, kind=INDEPENDENT_SOLUTION)
     fine = np.linspace(0.02, 3.0, 25)
     ex.curve("tip force", "elastica (scipy solve_bvp)", fine,
              [an.elastica_tip_force(a * EI / L**2, L, EI).tip[1] / L for a in fine],
@@ -79,7 +82,9 @@ def elastica(quick: bool = False) -> Experiment:
     errs = [abs(settled(Scene(ACT, segments=N), force=P)[1] - ref) / ref for N in Ns]
     order = -np.polyfit(np.log(Ns), np.log(errs), 1)[0]
     ex.check("hinge chain: convergence order of the tip error", "-", order, 2.0,
-             "midpoint rule: second order", tolerance=0.15)
+             "order of the error against the elastica (scipy solve_bvp); 2 = the composite midpoint rule's",
+             tolerance=0.15, kind=INDEPENDENT_SOLUTION,
+             note="a chain converging to another limit than the elastica leaves a constant error: order near 0")
     ex.curve("convergence", "mjeap hinge chain", Ns, np.array(errs) * 100, "segments N", "tip deflection error (%)", "o-")
     ex.curve("convergence", "N^-2 through N = 4", Ns, errs[0] * 100 * (Ns[0] / np.array(Ns)) ** 2,
              "segments N", "tip deflection error (%)", "--")
@@ -102,7 +107,9 @@ def vibration(quick: bool = False) -> Experiment:
             fs.append(f)
             refs.append(ref)
             ex.check(f"{rep}: f1 with {m * 1e6:g} mg at the tip", "Hz", f, ref,
-                     "cantilever with tip mass and rotary inertia (Erturk & Inman eq. 3.16)", tolerance=0.02)
+                     "continuum cantilever with tip mass and rotary inertia: root of its characteristic equation "
+                     "(Erturk & Inman 2011 eq. 3.16, brentq; equals the solve_bvp eigenproblem to 1e-11)",
+                     tolerance=0.02, kind=INDEPENDENT_SOLUTION)
         ex.curve("f1", f"mjeap {rep}", np.array(masses) * 1e6, fs, "tip mass (mg)", "f1 (Hz)", "o")
     mm = np.linspace(0, 12.6e-6, 30)
     ex.curve("f1", "characteristic equation", mm * 1e6,
@@ -125,13 +132,15 @@ def buckling(quick: bool = False) -> Experiment:
         tip = sc.tip_position()
         if factor < 1:
             ex.check(f"{factor:g} P_cr: lateral tip deflection at rest after a small push", "m", abs(tip[1]), 0.0,
-                     "stable column returns straight (tolerance: 1 % of the push)", tolerance=0.01 * y0,
-                     error_kind="absolute")
+                     "below P_cr of the column with its own weight (shooting: scipy solve_ivp + brentq) it returns "
+                     "straight (tolerance: 1 % of the push)", tolerance=0.01 * y0,
+                     error_kind="absolute", kind=INDEPENDENT_SOLUTION)
         else:
             ex.beam(f"{factor:g} P_cr: post-buckled, at rest", sc)
             x_ref, d_ref, _ = an.postbuckled_column(factor, L)
             ex.check(f"{factor:g} P_cr: post-buckled tip deflection", "m", abs(tip[1]), d_ref,
-                     "post-buckled elastica (elliptic integrals)", tolerance=0.03)
+                     "post-buckled elastica (elliptic integrals, Timoshenko & Gere 1961 sec. 2.7)", tolerance=0.03,
+                     kind=INDEPENDENT_SOLUTION)
             ex.curve("post-buckling", "mjeap hinge chain", [factor], [abs(tip[1]) / L],
                      "P / P_cr (-)", "tip deflection / L (-)", "o")
     ratios = np.linspace(1.0, 1.3, 30)
@@ -145,9 +154,11 @@ def section(quick: bool = False) -> Experiment:
     from ..catalog import PVDF_60
     ex = Experiment("mechanics-section", "Multilayer cross-section of 60PVDF (thesis eqs. 3.1-3.6)")
     s = PVDF_60.section_at(0.0)
-    ex.check("neutral axis z_c", "m", s.neutral_axis, 0.132e-3, "Metello 2020 (seed 002), sec. 3.3", tolerance=0.01)
-    ex.check("flexural rigidity EI", "N m^2", s.flexural_rigidity, 2.703e-5, "Metello 2020 (seed 002), sec. 3.3",
-             tolerance=0.01)
+    ex.check("neutral axis z_c", "m", s.neutral_axis, 0.132e-3,
+             "Metello 2020 (seed 002), Table 3.6: z_c = 0.132 mm (eqs. 3.1-3.3)", tolerance=0.01, kind=PUBLISHED_NUMBER)
+    ex.check("flexural rigidity EI", "N m^2", s.flexural_rigidity, 2.703e-5,
+             "Metello 2020 (seed 002), Table 3.7: EI = 2.703e7 Pa mm^4 (eqs. 3.4-3.5)", tolerance=0.01,
+             kind=PUBLISHED_NUMBER)
     # the layer model's beam (the catalog's pvdf-60 takes its EI from the measured 0 V slope)
     from dataclasses import replace
     sc = Scene(replace(PVDF_60, flexural_rigidity=None), gravity=False)
@@ -155,7 +166,9 @@ def section(quick: bool = False) -> Experiment:
     tip = settled(sc, force=P)
     ex.beam("60PVDF (layer model) under a 10 uN tip force (deflection as computed)", sc)
     ex.check("simulated 52 mm beam, layer-model EI: tip compliance", "m/N", tip[1] / P,
-             sc.layout.length**3 / (3 * 2.703e-5), "L^3 / (3 EI) with the thesis EI", tolerance=0.01)
+             sc.layout.length**3 / (3 * 2.703e-5),
+             "Metello 2020 eq. (3.12), z_m = W L^3 / (3 EI), with the EI of its Table 3.7 (2.703e-5 N m^2)",
+             tolerance=0.01, kind=PUBLISHED_FORMULA)
     ex.notes.append("The catalog's pvdf-60 uses the EI identified from its measured 0 V slope (23 % below this "
                     "layer model, see metello2020); this experiment checks the layer model itself.")
     return ex

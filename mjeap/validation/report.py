@@ -194,10 +194,12 @@ def write_markdown(experiments: List[Experiment], path: Path, figures: bool) -> 
             "'compare' rows set the simulation beside a published number or a model it is not "
             "expected to match within a tolerance; their notes say why they differ.", "",
             "Every toleranced row is against a reference independent of the code: "
-            + ", ".join(f"{v} against a {k}" for k, v in kinds.items())
-            + " (a published formula is transcribed with its equation; an independent solution is computed by a "
-            "different method: a BVP, quadrature, scipy's integrators, a published model's own equations). "
-            "'compare' rows include checks of a quantity against the number it was fitted to.", ""]
+            + ", ".join(f"{v} against {'an' if k[0] in 'aeiou' else 'a'} {k}" for k, v in kinds.items())
+            + " (a published number is printed in a source, named by its table or section; a published formula is "
+            "transcribed with its equation; an independent solution is computed by a different method: a BVP, an "
+            "eigenproblem, shooting, elliptic integrals, the exact continuum solution). 'compare' rows include "
+            "checks of a quantity against the number it was fitted to and round trips of the identification tool.",
+            ""]
     if not figures:
         head += ["(Figures need matplotlib: `pip install -e '.[report]'`.)", ""]
     path.write_text("\n".join(head) + "\n" + "\n".join(markdown_section(e, figures) for e in experiments))
