@@ -15,6 +15,7 @@ from mjeap.system import System, attach
 
 G = "0 0 -0.00980665"      # standard gravity in mm / ms^2
 VERTICAL = '<site name="mount" quat="0.7071068 0.7071068 0 0"/>'   # deflection along z: gravity bends it
+UP = '<site name="mount" quat="0.7071068 0 -0.7071068 0"/>'         # beam along z: gravity loads it axially
 
 
 def host(body: str = '<site name="mount"/>', option: str = "", gravity: str = G) -> mujoco.MjSpec:
@@ -74,9 +75,10 @@ def test_system_timestep_below_the_twins_keeps_the_damping_ratio():
 
 # 3 ------------------------------------------------------------------------------------------
 def test_host_without_gravity_sizes_its_actuators_without_it():
-    """<flag gravity="disable"/>: the twin was sized with gravity (damping ratio off by 4.9 %
-    here). Now as Scene(gravity=False): same choice, same trajectory."""
-    spec = host(VERTICAL, '<flag gravity="disable"/>')
+    """<flag gravity="disable"/>: the twin was sized with gravity (a standing beam with a
+    payload: its first mode and with it the damping and timestep off). Now as
+    Scene(gravity=False): same choice, same trajectory."""
+    spec = host(UP, '<flag gravity="disable"/>')
     a = attach(spec, "pedot-micro", site="mount", prefix="a", payload="12.6mg@6.27mm", contact=False)
     ref_scene = Scene("pedot-micro", orientation=a.twin.rotation, payload="12.6mg@6.27mm", gravity=False)
     assert a.twin.choice == ref_scene.choice
@@ -125,6 +127,7 @@ def _numerics_model(*numerics) -> mujoco.MjModel:
         '<geom size="1" mass="1"/></body></worldbody></mujoco>')
 
 
+@pytest.mark.filterwarnings("ignore:MuJoCo. XML contains a 'NaN'")
 @pytest.mark.parametrize("data", ["nan 1", "1 -1", "1 inf"])
 def test_load_mjcf_refuses_bad_dof_damping(tmp_path, data):
     path = tmp_path / "m.xml"
@@ -135,6 +138,7 @@ def test_load_mjcf_refuses_bad_dof_damping(tmp_path, data):
         load_mjcf(path)
 
 
+@pytest.mark.filterwarnings("ignore:MuJoCo. XML contains a 'NaN'")
 def test_read_units_reads_its_own_field_only():
     """A short mjeap_units was read on into the next numeric (MuJoCo keeps them in one array)."""
     m = _numerics_model(("mjeap_units", "0.001 1e-6"), ("other", "5"))
