@@ -86,7 +86,9 @@ class CurvatureTrackingTask(base.Task):
 
     Randomised at every reset (``random``: seed or numpy Generator/RandomState): the payload
     mass uniformly in ``payload_mass_range`` (kg, needs a scene with a payload), the initial
-    curvature uniformly in ``initial_curvature_range`` (1/m). Actions outside the safe range
+    curvature uniformly in ``initial_curvature_range`` (1/m, both bounds within rollout's:
+    finite, at most a full circle over the beam). An action is one voltage (shape (1,));
+    more values are refused, not cut. Actions outside the safe range
     are clipped, counted in ``saturated_steps`` and warned about once per episode."""
 
     def __init__(self, reference: Callable[[float], float], payload_mass_range: Optional[Tuple[float, float]] = None,
@@ -137,7 +139,7 @@ class CurvatureTrackingTask(base.Task):
         return specs.BoundedArray((1,), np.float64, lo, hi, name="voltage (V)")
 
     def before_step(self, action, physics: BeamPhysics) -> None:
-        u = one_voltage(action, "action", f"the action_spec is shape (1,), the voltage in V of {physics.scene.actuator.id}")
+        u = one_voltage(action, "action", f"the action_spec: shape (1,), the voltage of {physics.scene.actuator.id}")
         if not np.isfinite(u):
             raise ParameterError("action", u, "a finite voltage in V")
         lo, hi = physics.drive.voltage_range()

@@ -201,7 +201,10 @@ def attach(spec: mujoco.MjSpec, actuator, *, prefix: str, site: Optional[str] = 
     ``integrator`` defaults to 'discrete' with contact (MuJoCo solves contacts in the
     metric of its implicit update there; under 'implicitfast' contact impulses are sized
     for M alone and kick the heavily damped short modes of a beam: tested) and
-    'implicitfast' without; the timestep and damping follow from it (:mod:`mjeap.scene`)."""
+    'implicitfast' without; the timestep and damping follow from it (:mod:`mjeap.scene`).
+    The host's flags are read: under ``<flag gravity="disable"/>`` the beam is sized without
+    gravity; springs or dampers switched off (and actuation, for a driven beam) are refused.
+    With ``contact`` the beam's own parts (its payload, neighbouring links) never touch."""
     units = units or DEFAULT_UNITS
     integrator = integrator or ("discrete" if contact else "implicitfast")
     if not isinstance(prefix, str) or not _PREFIX.match(prefix):
@@ -308,8 +311,11 @@ class SystemResult:
 class System:
     """A compiled MuJoCo system: a host ``spec`` with ``actuators`` attached by
     :func:`attach` (all in ``units``), other bodies, joints, constraints and contact.
-    ``timestep`` (s) defaults to the smallest of the actuators' own choices; a larger one is
-    refused with the limit. The integrator is the actuators' (they were attached for one:
+    ``timestep`` (s) defaults to the smallest of the actuators' own choices; one beyond an
+    actuator's limits (:meth:`~mjeap.Scene.check_timestep`: stability, and under 'discrete'
+    accuracy and beta / 2) is refused with the limit; under 'discrete' the hinges' damping
+    is (beta - h) k of the system's h. The host's flags and gravity must still be those the
+    actuators were attached under. The integrator is the actuators' (they were attached for one:
     'discrete' with contact, see :func:`attach`); ``integrator`` is needed only without
     actuators. ``contact``: :class:`ContactParameters` (None: the host's own)."""
 
@@ -357,7 +363,7 @@ class System:
             self.timestep_reason = "given by the user"
         self.spec = spec
         for a in self.actuators:
-            if a.twin.integrator == "discrete" and a.twin.representation == "hinge" and h != a.twin.timestep:
+            if a.twin.integrator == "discrete" and a.twin.representation == "hinge":
                 # discrete damps the beam by h K itself: the joints carry beta - h of the system's h
                 for name, b in zip(a.joints, a.twin.joint_damping(h)):
                     spec.joint(name).damping = [float(b), 0.0, 0.0]

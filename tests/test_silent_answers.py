@@ -71,6 +71,8 @@ def test_system_timestep_below_the_twins_keeps_the_damping_ratio():
     s = System(spec, [a], timestep=a.twin.timestep / 2)
     _, zeta = first_mode_damping(linearize(s.model), s.model.dof_damping, s.model.opt.timestep, "discrete")
     assert zeta == pytest.approx(0.05, rel=0.02)
+    again = System(spec, [a])                # the same host at the twin's own step: the twin's damping again
+    assert np.array_equal(again.model.dof_damping, a.twin.model.dof_damping)
 
 
 # 3 ------------------------------------------------------------------------------------------
