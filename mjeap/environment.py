@@ -30,9 +30,24 @@ from . import install_mujoco_warnings
 from .discretize import Payload
 from .drives import make_drive
 from .errors import ParameterError, check_positive, check_range
+from .rollout import check_initial_curvature, one_voltage
 from .scene import Scene
 
 install_mujoco_warnings()         # dm_control's import installed its own MuJoCo warning handler
+
+
+def check_curvature_range(bounds, length: Optional[float]) -> Tuple[float, float]:
+    """``(low, high)`` initial curvatures (1/m) with low <= high, each within rollout's
+    bounds for a beam of ``length`` m (finite, at most a full circle; None: order only)."""
+    try:
+        lo, hi = (float(x) for x in bounds)
+    except (TypeError, ValueError):
+        raise ParameterError("initial_curvature_range", bounds, "(low, high) 1/m") from None
+    for k in (lo, hi) if length is not None else ():
+        check_initial_curvature(k, length, "initial_curvature_range")
+    if lo > hi:
+        raise ParameterError("initial_curvature_range", bounds, "(low, high) 1/m with low <= high")
+    return lo, hi
 
 
 class BeamPhysics(engine.Physics):
@@ -71,7 +86,9 @@ class CurvatureTrackingTask(base.Task):
 
     Randomised at every reset (``random``: seed or numpy Generator/RandomState): the payload
     mass uniformly in ``payload_mass_range`` (kg, needs a scene with a payload), the initial
-    curvature uniformly in ``initial_curvature_range`` (1/m). Actions outside the safe range
+    curvature uniformly in ``initial_curvature_range`` (1/m, both bounds within rollout's:
+    finite, at most a full circle over the beam). An action is one voltage (shape (1,));
+    more values are refused, not cut. Actions outside the safe range
     are clipped, counted in ``saturated_steps`` and warned about once per episode."""
 
     def __init__(self, reference: Callable[[float], float], payload_mass_range: Optional[Tuple[float, float]] = None,
@@ -84,10 +101,7 @@ class CurvatureTrackingTask(base.Task):
             if not (0 < lo <= hi):
                 raise ParameterError("payload_mass_range", payload_mass_range, "(low, high) kg with 0 < low <= high")
         self.payload_mass_range = payload_mass_range
-        lo, hi = (float(x) for x in initial_curvature_range)
-        if lo > hi:
-            raise ParameterError("initial_curvature_range", initial_curvature_range, "(low, high) 1/m with low <= high")
-        self.initial_curvature_range = (lo, hi)
+        self.initial_curvature_range = check_curvature_range(initial_curvature_range, None)   # bounds: per beam
         self.reward_margin = check_positive("reward_margin", reward_margin, "1/m")
         self.reward_fn = reward_fn
         self.saturated_steps = 0
@@ -109,6 +123,7 @@ class CurvatureTrackingTask(base.Task):
                                              Payload(mass, p.position, p.sphere_radius).inertia) / u.inertia
             mujoco.mj_setConst(m, physics.data.ptr)
             self.episode["payload_mass_kg"] = mass
+        check_curvature_range(self.initial_curvature_range, sc.layout.length)
         kappa0 = float(self.random.uniform(*self.initial_curvature_range))
         self.episode["initial_curvature_per_m"] = kappa0
         if kappa0:
@@ -124,7 +139,7 @@ class CurvatureTrackingTask(base.Task):
         return specs.BoundedArray((1,), np.float64, lo, hi, name="voltage (V)")
 
     def before_step(self, action, physics: BeamPhysics) -> None:
-        u = float(np.asarray(action, dtype=float).reshape(-1)[0])
+        u = one_voltage(action, "action", f"the action_spec: shape (1,), the voltage of {physics.scene.actuator.id}")
         if not np.isfinite(u):
             raise ParameterError("action", u, "a finite voltage in V")
         lo, hi = physics.drive.voltage_range()
@@ -175,6 +190,7 @@ def make_environment(actuator: str = "pedot-micro", reference: Optional[Callable
         def reference(t):
             return 50.0 * np.sin(2 * np.pi * 0.05 * t)
     scene = Scene(actuator, orientation=orientation, payload=payload, segments=segments)
+    check_curvature_range(initial_curvature_range, scene.layout.length)
     drv = make_drive(drive, scene, **(drive_params or {}))
     check_range("control_interval", control_interval, scene.timestep, time_limit, "s")
     physics = BeamPhysics.from_scene(scene, drv)

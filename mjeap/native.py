@@ -28,6 +28,7 @@ from typing import Dict, List, Optional
 import mujoco
 import numpy as np
 
+from .errors import ParameterError
 from .units import UnitSystem
 
 UNITS_FIELD = "mjeap_units"
@@ -60,13 +61,32 @@ def add_units(spec: mujoco.MjSpec, units: UnitSystem) -> None:
     spec.add_numeric(name=UNITS_FIELD, data=[units.length, units.mass, units.time])
 
 
-def read_units(model: mujoco.MjModel) -> Optional[UnitSystem]:
-    """The unit system a model declares in ``mjeap_units`` (None if it declares none)."""
-    i = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_NUMERIC, UNITS_FIELD)
+def read_numeric(model: mujoco.MjModel, name: str, size: int, accepted: str,
+                 positive: bool = False) -> Optional[np.ndarray]:
+    """The values of the custom numeric ``name`` (None if the model has none), refused
+    unless there are exactly ``size`` of them, finite and >= 0 (> 0 if ``positive``):
+    MuJoCo keeps every numeric in one array, so a short field read at its length would
+    run into the next one. ``accepted`` says what they are, for the message."""
+    i = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_NUMERIC, name)
     if i < 0:
         return None
-    a = model.numeric_adr[i]
-    return UnitSystem(*map(float, model.numeric_data[a:a + 3]))
+    a, n = int(model.numeric_adr[i]), int(model.numeric_size[i])
+    v = np.array(model.numeric_data[a:a + n], dtype=float)
+    if n != size:
+        raise ParameterError(name, f"{n} values", f"{size} values: {accepted}")
+    bad = ~np.isfinite(v) | ((v <= 0) if positive else (v < 0))
+    if bad.any():
+        j = int(np.argmax(bad))
+        raise ParameterError(name, f"{float(v[j])!r} at index {j}",
+                             f"finite values {'> 0' if positive else '>= 0'}: {accepted}")
+    return v
+
+
+def read_units(model: mujoco.MjModel) -> Optional[UnitSystem]:
+    """The unit system a model declares in ``mjeap_units`` (None if it declares none)."""
+    v = read_numeric(model, UNITS_FIELD, 3, "L M T, the SI size of one internal length (m), mass (kg) "
+                     "and time (s) unit", positive=True)
+    return None if v is None else UnitSystem(*map(float, v))
 
 
 def add_bending_tendon(spec: mujoco.MjSpec, joints, coefficients, name: str = TENDON):

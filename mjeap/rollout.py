@@ -270,6 +270,20 @@ def _waveform(voltage, duration: float):
     return wave.with_duration(duration) if isinstance(wave, Waveform) else wave
 
 
+def one_voltage(value, name: str, where: str = "") -> float:
+    """A policy's or controller's command for one actuator as a voltage (V): a number or a
+    one-element array (shape (1,), a dm_env action); more values (two for one actuator),
+    none or text are refused naming the shape expected, never cut to the first."""
+    accepted = "one voltage in V for one actuator: a number or an array of shape (1,)"
+    try:
+        a = np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        raise ParameterError(name, value, accepted, where) from None
+    if a.size != 1:
+        raise ParameterError(name, f"{value!r} (shape {a.shape})", accepted, where)
+    return float(a.reshape(-1)[0])
+
+
 #: the largest initial bend accepted: a uniform arc closing into a full circle
 MAX_INITIAL_BEND = 2 * np.pi
 
@@ -421,7 +435,9 @@ def _run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, pro
             if controller is not None:
                 if k % ctrl_every == 0:
                     scene.update_kinematics()
-                    u = float(controller(k * dt, scene))
+                    u = controller(k * dt, scene)
+                    if not isinstance(u, float):
+                        u = one_voltage(u, "controller command", f"{ctrl_name} at t = {k * dt:.6g} s")
                     if not math.isfinite(u):     # not a clipping case: name who and when
                         raise ParameterError("controller command", u, "a finite voltage",
                                              f"{ctrl_name} at t = {k * dt:.6g} s")
@@ -473,7 +489,8 @@ def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable
                   sample_interval: Optional[float] = None, nthread: Optional[int] = None,
                   engine: str = "auto") -> List[RolloutResult]:
     """Many rollouts of one scene, one per entry of ``voltages`` (and of
-    ``initial_curvatures``, 1/m, a scalar for all), on MuJoCo's threaded rollout with
+    ``initial_curvatures``, 1/m, a scalar for all; a single waveform runs once per initial
+    curvature, or once), on MuJoCo's threaded rollout with
     ``nthread`` threads (default: one per CPU): the drive compiled into the model
     (``native``) or its moment history as applied forces (``threaded``); ``auto`` takes
     the first that applies. Same results as :func:`rollout` run one by one with that
@@ -483,10 +500,16 @@ def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable
     from . import threaded
 
     duration = check_positive("duration", duration, "s")
+    k0 = np.asarray(initial_curvatures, dtype=float)
+    if isinstance(voltages, (str, int, float)) or callable(voltages):   # one waveform, not its characters
+        voltages = [voltages] * (k0.size if k0.ndim == 1 else 1)
     voltages = list(voltages)
     if not voltages:
         raise ParameterError("voltages", voltages, "at least one waveform")
-    kappa0 = np.broadcast_to(np.asarray(initial_curvatures, dtype=float), (len(voltages),))
+    if k0.ndim > 1 or (k0.ndim == 1 and k0.size != len(voltages)):
+        raise ParameterError("initial_curvatures", f"{k0.size} values (shape {k0.shape})",
+                             f"one number for every run, or one per run ({len(voltages)} voltages)")
+    kappa0 = np.broadcast_to(k0, (len(voltages),))
     for k in kappa0:
         check_initial_curvature(k, scene.layout.length, "initial_curvatures")
     drives = [make_drive(drive, scene, **(drive_params or {})) for _ in voltages]

@@ -29,7 +29,10 @@ Damping and timestep are derived from the compiled model, never tuned by hand:
    where T_1 grows without bound but the beam's elastic response to a drive does not; the
    factor 2 keeps away from the stability limit, which moves slightly with the
    large-deflection geometry. A user timestep above h_stab is refused with the limit in the
-   message.
+   message; under ``discrete`` on the hinge chain (no h_stab) so is one above T_1 / 50
+   (accuracy) or beta / 2 (the joints' share (beta - h) k of the damping would fall below
+   half, and to nothing at h = beta) (:meth:`Scene.check_timestep`, which a
+   :class:`~mjeap.System` applies to every attached beam).
 """
 from __future__ import annotations
 
@@ -49,6 +52,7 @@ from .discretize import BeamLayout, Payload, check_payload, clamp_rotation, disc
 from .errors import DivergenceError, ParameterError, check_positive, check_range
 from .mjcf import build_spec, get_builder
 from .modes import linearize, modal_frequencies, stability_limit
+from .native import read_numeric
 from .units import DEFAULT_UNITS, UnitSystem
 
 STEPS_PER_PERIOD = 50
@@ -83,13 +87,25 @@ def _floor_sig(x: float, digits: int) -> float:
 
 
 def apply_dof_damping(model: mujoco.MjModel) -> mujoco.MjModel:
-    """Apply the per-dof Rayleigh damping stored in a generated model (cable), in place."""
-    i = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_NUMERIC, DOF_DAMPING_FIELD)
-    if i >= 0:
-        a, n = model.numeric_adr[i], model.numeric_size[i]
-        if n != model.nv:
-            raise ParameterError(DOF_DAMPING_FIELD, n, f"{model.nv} values (one per dof)")
-        model.dof_damping[:] = model.numeric_data[a:a + n]
+    """Apply the per-dof Rayleigh damping stored in a generated model (cable), in place:
+    ``mjeap_dof_damping`` holds one value per dof of the model, ``PREFIX/mjeap_dof_damping``
+    (a beam attached under ``PREFIX/``, :mod:`mjeap.system`) one per dof of the joints
+    named ``PREFIX/...``, in dof order. Values that are not finite and >= 0, or not one per
+    dof, are refused with the field named."""
+    for i in range(model.nnumeric):
+        name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_NUMERIC, i) or ""
+        prefix = name[:-len(DOF_DAMPING_FIELD)]
+        if not name.endswith(DOF_DAMPING_FIELD) or not (prefix == "" or prefix.endswith("/")):
+            continue
+        if prefix:
+            joints = [j for j in range(model.njnt)
+                      if (mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j) or "").startswith(prefix)]
+            dofs = np.flatnonzero(np.isin(model.dof_jntid, joints))
+        else:
+            dofs = np.arange(model.nv)
+        model.dof_damping[dofs] = read_numeric(
+            model, name, len(dofs), f"one damping per dof of {'the model' if not prefix else repr(prefix)} "
+            "(internal units)")
     return model
 
 
@@ -231,8 +247,22 @@ class Scene:
         h_acc = T_short / STEPS_PER_PERIOD
         # backward Euler on the hinge springs damps like Rayleigh damping with beta = h
         numerical = self.integrator == "discrete" and self.representation == "hinge"
-        if numerical and beta > 0:
-            h_acc = min(h_acc, 0.5 * beta)
+        # the limits a timestep must keep (internal, why): stability, and under 'discrete' on
+        # the hinge chain (no stability limit there) accuracy and the joints' share of beta
+        self._timestep_limits = [(h_stab, (
+            f"stability limit of {self.actuator.id} ({self.representation}, {self.layout.segments} "
+            f"segments) under {self.integrator}: highest bending mode {wmax / u.time / 2 / np.pi:.4g} Hz "
+            f"with explicit stiffness, Rayleigh damping beta = {beta * u.time:.3g} s"))]
+        if numerical:
+            self._timestep_limits.append((T_short / STEPS_PER_PERIOD, (
+                f"accuracy under discrete: {STEPS_PER_PERIOD} steps per period of the first mode of "
+                f"{self.actuator.id} (T = {T_short * u.time:.4g} s)")))
+            if beta > 0:
+                h_acc = min(h_acc, 0.5 * beta)
+                self._timestep_limits.append((0.5 * beta, (
+                    f"damping under discrete: the step damps the first mode by beta = h itself and the joints "
+                    f"carry the rest (beta - h) K of {self.actuator.id}'s Rayleigh beta = {beta * u.time:.4g} s "
+                    f"(damping ratio {zeta:g}); h <= beta / 2 keeps at least half in the joints")))
         if timestep is None:
             # rounded down to 3 significant figures in SI: a clean number that does not
             # depend on the internal units (the limit itself is known to ~1e-4)
@@ -244,25 +274,40 @@ class Scene:
                       + (f", beta/2 = {0.5 * beta * u.time:.3g} s under discrete" if numerical and beta > 0 else "")
                       + ")")
         else:
-            h = check_positive("timestep", timestep, "s") / u.time
-            if h > h_stab:
-                raise ParameterError(
-                    "timestep", timestep,
-                    f"a timestep <= {h_stab * u.time:.4g} s",
-                    f"stability limit of {self.actuator.id} ({self.representation}, {self.layout.segments} "
-                    f"segments) under {self.integrator}: highest bending mode {wmax / u.time / 2 / np.pi:.4g} Hz "
-                    f"with explicit stiffness, Rayleigh damping beta = {beta * u.time:.3g} s")
+            h = self.check_timestep(timestep) / u.time
             reason = "given by the user"
         self.spec.option.timestep = h
         h_num = h if numerical else 0.0
-        if numerical:
-            for j, name in enumerate(self.handles.joints):
-                self.spec.joint(name).damping = [max(beta - h, 0.0) * kj[j], 0, 0]
-        return TimestepChoice(
+        choice = TimestepChoice(
             timestep=h * u.time, stability_limit=h_stab * u.time, accuracy_limit=h_acc * u.time,
             first_frequency=w1 / u.time / (2 * np.pi), highest_frequency=wmax / u.time / (2 * np.pi),
             damping_ratio=zeta, rayleigh_beta=beta * u.time, integrator_beta=h_num * u.time, integrator=self.integrator,
             buckled=buckled, reason=reason)
+        if numerical:
+            for name, b in zip(self.handles.joints, self.joint_damping(h * u.time, choice)):
+                self.spec.joint(name).damping = [b, 0, 0]
+        return choice
+
+    def check_timestep(self, timestep: float, name: str = "timestep") -> float:
+        """``timestep`` (s), refused with the limit and its reason where this beam would not
+        run correctly at it: above its stability limit; under 'discrete' on the hinge chain
+        (no stability limit) above T_1 / 50 (accuracy) or beta / 2 (the joints' damping
+        (beta - h) K would fall below half of it, and to 0 at h = beta)."""
+        h = check_positive(name, timestep, "s")
+        u = self.units
+        for limit, why in sorted(self._timestep_limits, key=lambda x: x[0]):    # the tightest named
+            if h > limit * u.time * (1 + 1e-9):
+                raise ParameterError(name, timestep, f"a timestep <= {_floor_sig(limit * u.time, 4):.4g} s", why)
+        return h
+
+    def joint_damping(self, timestep: float, choice: Optional[TimestepChoice] = None) -> np.ndarray:
+        """Damping of each bending joint (internal units) that gives the first mode its
+        damping ratio when stepped at ``timestep`` (s): beta k_j, of which 'discrete' adds
+        h k_j itself on the hinge chain (backward Euler on the springs)."""
+        c, u = choice or self.choice, self.units
+        numerical = c.integrator == "discrete" and self.representation == "hinge"
+        beta = c.rayleigh_beta - (timestep if numerical else 0.0)
+        return max(beta, 0.0) / u.time * self.layout.hinge_stiffness / u.rotational_stiffness
 
     def _uniform_arc_qpos(self, model: mujoco.MjModel, tip_angle: float) -> np.ndarray:
         q = model.qpos0.copy()

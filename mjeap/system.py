@@ -31,7 +31,8 @@ import numpy as np
 from . import native
 from .component import ActuatorPart
 from .errors import DivergenceError, ParameterError, UnknownNameError, check_positive
-from .scene import DEFAULT_SEGMENTS, INTEGRATORS, Scene, diverged
+from .rollout import one_voltage
+from .scene import DEFAULT_SEGMENTS, INTEGRATORS, Scene, apply_dof_damping, diverged
 from .units import DEFAULT_UNITS, UnitSystem
 
 _PREFIX = re.compile(r"^[A-Za-z][A-Za-z0-9_-]*$")
@@ -139,8 +140,37 @@ def _mount(spec: mujoco.MjSpec, site, body, frame):
     return kind, name, el
 
 
-def _mount_rotation(spec: mujoco.MjSpec, kind: str, name: str, el) -> tuple:
-    """World rotation of the mount at the host's qpos0 and the host's gravity (internal)."""
+#: host flags that would switch off part of what an attached beam is: (bit, flag, why)
+_BEAM_FLAGS = (
+    (mujoco.mjtDisableBit.mjDSBL_SPRING, "spring",
+     "the beam's bending stiffness is its joints' springs (and the cable plugin's forces): it would fall limp"),
+    (mujoco.mjtDisableBit.mjDSBL_DAMPER, "damper",
+     "the beam's Rayleigh damping is its joints' dampers, and its timestep is chosen with them: without them it "
+     "rings or diverges"),
+)
+_DRIVE_FLAGS = (
+    (mujoco.mjtDisableBit.mjDSBL_ACTUATION, "actuation",
+     "a drive is a MuJoCo actuator: nothing would be driven while its voltage is recorded (attach the beam "
+     "with passive=True to run it without a drive)"),
+)
+
+
+def host_gravity(option, driven: bool) -> np.ndarray:
+    """The gravity (internal units) the host's ``option`` applies: zero under its
+    ``<flag gravity="disable"/>``. Flags that would switch off part of an attached beam
+    (springs, dampers; actuation where a beam is ``driven``) are refused with the flag named."""
+    flags = int(option.disableflags)
+    for bit, flag, why in _BEAM_FLAGS + (_DRIVE_FLAGS if driven else ()):
+        if flags & int(bit):
+            raise ParameterError(f"<flag {flag}>", "disable", "'enable' (the default) in a host with mjeap actuators",
+                                 why)
+    if flags & int(mujoco.mjtDisableBit.mjDSBL_GRAVITY):
+        return np.zeros(3)
+    return np.array(option.gravity, dtype=float)
+
+
+def _mount_rotation(spec: mujoco.MjSpec, kind: str, name: str, el) -> np.ndarray:
+    """World rotation of the mount at the host's qpos0."""
     m = spec.copy().compile()
     d = mujoco.MjData(m)
     mujoco.mj_kinematics(m, d)
@@ -153,7 +183,7 @@ def _mount_rotation(spec: mujoco.MjSpec, kind: str, name: str, el) -> tuple:
             q = np.zeros(9)
             mujoco.mju_quat2Mat(q, np.asarray(el.quat, dtype=float) / np.linalg.norm(el.quat))
             R = R @ q.reshape(3, 3)
-    return R.copy(), m.opt.gravity.copy()
+    return R.copy()
 
 
 def attach(spec: mujoco.MjSpec, actuator, *, prefix: str, site: Optional[str] = None, body: Optional[str] = None,
@@ -171,7 +201,10 @@ def attach(spec: mujoco.MjSpec, actuator, *, prefix: str, site: Optional[str] = 
     ``integrator`` defaults to 'discrete' with contact (MuJoCo solves contacts in the
     metric of its implicit update there; under 'implicitfast' contact impulses are sized
     for M alone and kick the heavily damped short modes of a beam: tested) and
-    'implicitfast' without; the timestep and damping follow from it (:mod:`mjeap.scene`)."""
+    'implicitfast' without; the timestep and damping follow from it (:mod:`mjeap.scene`).
+    The host's flags are read: under ``<flag gravity="disable"/>`` the beam is sized without
+    gravity; springs or dampers switched off (and actuation, for a driven beam) are refused.
+    With ``contact`` the beam's own parts (its payload, neighbouring links) never touch."""
     units = units or DEFAULT_UNITS
     integrator = integrator or ("discrete" if contact else "implicitfast")
     if not isinstance(prefix, str) or not _PREFIX.match(prefix):
@@ -180,15 +213,16 @@ def attach(spec: mujoco.MjSpec, actuator, *, prefix: str, site: Optional[str] = 
         raise ParameterError("prefix", prefix, "a prefix not used yet in this model (an actuator is attached "
                              f"under '{prefix}/' already)")
     kind, name, el = _mount(spec, site, body, frame)
-    R, g = _mount_rotation(spec, kind, name, el)
-    twin = Scene(actuator, representation=representation, segments=segments, orientation=R, payload=payload,
-                 units=units, damping_ratio=damping_ratio, gravity=bool(np.any(g)), integrator=integrator)
+    g = host_gravity(spec.option, driven=not passive)
     gs = g * units.acceleration
     if np.any(g) and not np.allclose(gs, [0, 0, -9.80665], rtol=2e-3):
         raise ParameterError("spec.option.gravity", f"{gs} m/s^2 (in the declared units {units.describe()})",
                              f"standard gravity along -z, 0 0 {-9.80665 / units.acceleration:.9g} in these units "
                              "(9.81 m/s^2), or none: the actuator's damping and timestep are chosen for it "
                              "(a host in other units: declare them with units=)")
+    R = _mount_rotation(spec, kind, name, el)
+    twin = Scene(actuator, representation=representation, segments=segments, orientation=R, payload=payload,
+                 units=units, damping_ratio=damping_ratio, gravity=bool(np.any(g)), integrator=integrator)
     drv, nat = None, None
     if passive:
         child = twin.spec.copy()
@@ -204,9 +238,9 @@ def attach(spec: mujoco.MjSpec, actuator, *, prefix: str, site: Optional[str] = 
         if n.name == native.UNITS_FIELD:
             child.delete(n)
     if contact:
-        for j in range(twin.layout.segments):
-            g_ = child.geom(f"link{j}")
-            g_.contype, g_.conaffinity, g_.condim = 1, 1, 3
+        for b in twin.handles.link_bodies:              # the hinge chain's links, the cable's segments
+            for g_ in child.body(b).geoms:
+                g_.contype, g_.conaffinity, g_.condim = 1, 1, 3
         if twin.payload is not None:
             child.geom("payload").contype, child.geom("payload").conaffinity = 1, 1
     o, co = spec.option, child.option         # the host's options rule; say so to MjSpec
@@ -216,7 +250,21 @@ def attach(spec: mujoco.MjSpec, actuator, *, prefix: str, site: Optional[str] = 
     clamp.pos, clamp.quat = [0, 0, 0], [1, 0, 0, 0]       # the mount's frame is the clamp frame
     target = el if kind != "body" else el.add_frame()
     target.attach_body(clamp, prefix + "/", "")
+    if contact:
+        _exclude_own_contacts(spec, twin.handles, prefix + "/")
     return AttachedActuator(prefix + "/", twin, drv, nat, contact)
+
+
+def _exclude_own_contacts(spec: mujoco.MjSpec, handles, prefix: str) -> None:
+    """A beam's own parts never touch each other: its payload sphere (it overlaps the links
+    it is mounted beside) and its neighbouring links (MuJoCo filters parent and child only
+    while the host keeps its filterparent flag) are excluded pairs."""
+    links = [prefix + b for b in handles.link_bodies]
+    for b1, b2 in zip(links[:-1], links[1:]):
+        spec.add_exclude(bodyname1=b1, bodyname2=b2)
+    if handles.payload_body:
+        for b in links:
+            spec.add_exclude(bodyname1=prefix + handles.payload_body, bodyname2=b)
 
 
 def add_transmission(spec: mujoco.MjSpec, actuator: AttachedActuator, joint: str, ratio: float) -> None:
@@ -263,8 +311,11 @@ class SystemResult:
 class System:
     """A compiled MuJoCo system: a host ``spec`` with ``actuators`` attached by
     :func:`attach` (all in ``units``), other bodies, joints, constraints and contact.
-    ``timestep`` (s) defaults to the smallest of the actuators' own choices; a larger one is
-    refused with the limit. The integrator is the actuators' (they were attached for one:
+    ``timestep`` (s) defaults to the smallest of the actuators' own choices; one beyond an
+    actuator's limits (:meth:`~mjeap.Scene.check_timestep`: stability, and under 'discrete'
+    accuracy and beta / 2) is refused with the limit; under 'discrete' the hinges' damping
+    is (beta - h) k of the system's h. The host's flags and gravity must still be those the
+    actuators were attached under. The integrator is the actuators' (they were attached for one:
     'discrete' with contact, see :func:`attach`); ``integrator`` is needed only without
     actuators. ``contact``: :class:`ContactParameters` (None: the host's own)."""
 
@@ -289,7 +340,17 @@ class System:
         if integrator not in INTEGRATORS:
             raise ParameterError("integrator", integrator, f"one of {', '.join(INTEGRATORS)}")
         self.integrator = integrator
-        h_limit = min((a.twin.choice.stability_limit for a in self.actuators), default=np.inf)
+        if self.actuators:
+            # the host's flags and gravity now, against those each twin was sized for at attach
+            g = host_gravity(spec.option, driven=any(a.drive is not None for a in self.actuators))
+            for a in self.actuators:
+                g_twin = a.twin.model.opt.gravity * units.acceleration
+                if not np.allclose(g * units.acceleration, g_twin, rtol=2e-3):
+                    raise ParameterError(
+                        "spec.option.gravity", f"{g * units.acceleration} m/s^2 (with its gravity flag)",
+                        f"the gravity actuator '{a.prefix.rstrip('/')}' was attached under, {g_twin} m/s^2",
+                        "its damping and timestep were chosen for that gravity: set the host's gravity and its flag "
+                        "before attach")
         if timestep is None:
             if not self.actuators:
                 raise ParameterError("timestep", None, "a timestep in s for a system without actuators")
@@ -297,11 +358,15 @@ class System:
             self.timestep_reason = "the smallest of the actuators' own timesteps"
         else:
             h = check_positive("timestep", timestep, "s")
-            if h > h_limit:
-                raise ParameterError("timestep", timestep, f"a timestep <= {h_limit:.4g} s",
-                                     "the stability limit of the stiffest attached actuator")
+            for a in self.actuators:          # stability; accuracy and the joints' damping under discrete
+                a.twin.check_timestep(timestep)
             self.timestep_reason = "given by the user"
         self.spec = spec
+        for a in self.actuators:
+            if a.twin.integrator == "discrete" and a.twin.representation == "hinge":
+                # discrete damps the beam by h K itself: the joints carry beta - h of the system's h
+                for name, b in zip(a.joints, a.twin.joint_damping(h)):
+                    spec.joint(name).damping = [float(b), 0.0, 0.0]
         spec.option.timestep = h / units.time
         spec.option.integrator = INTEGRATORS[integrator]
         spec.option.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_AUTORESET)
@@ -311,10 +376,11 @@ class System:
         self.contact = contact
         native.add_units(spec, units)
         try:
-            self.model = spec.compile()
+            model = spec.compile()
         except ValueError as e:
             raise ParameterError("spec", spec.modelname, "a host model that compiles with its actuators",
                                  str(e).splitlines()[0]) from None
+        self.model = apply_dof_damping(model)         # a cable's per-dof damping (PREFIX/mjeap_dof_damping)
         self.data = mujoco.MjData(self.model)
         m = self.model
         self.parts: List[ActuatorPart] = []
@@ -398,7 +464,15 @@ class System:
         self._step_count = 0
 
     def _per_actuator(self, name: str, values) -> list:
-        if np.ndim(values) == 0 and not isinstance(values, (str, dict)):
+        """One value per actuator from a list, a dict by prefix or one value for all; a bare
+        text (a waveform) is one actuator's, so only a system of one takes it."""
+        if isinstance(values, str):
+            if len(self) == 1:
+                return [values]
+            raise ParameterError(name, values, f"one per actuator ({len(self)}: "
+                                 f"{', '.join(a.prefix.rstrip('/') for a in self.actuators)}) as a list or a dict "
+                                 "by prefix: a single text is taken for a system of one actuator only")
+        if np.ndim(values) == 0 and not isinstance(values, dict):
             return [values] * len(self)
         if isinstance(values, dict):
             out = [None] * len(self)
@@ -416,6 +490,7 @@ class System:
         for a, i, v in zip(self.actuators, self.actuator_ids, self._per_actuator("voltages", voltages)):
             if i < 0 or v is None:
                 continue
+            v = one_voltage(v, f"voltage of '{a.prefix.rstrip('/')}'")
             a.drive.check_voltage(np.asarray([v], dtype=float))
             self.data.ctrl[i] = v
 
@@ -462,6 +537,8 @@ class System:
                 if k:
                     vs[k] = vs[k - 1]
                 continue
+            if not isinstance(v, float):
+                v = one_voltage(v, f"controller voltage of '{a.prefix.rstrip('/')}'", f"at t = {self.time:.6g} s")
             lo, hi = a.drive.voltage_range()
             if not (lo - 1e-12 <= v <= hi + 1e-12):
                 raise ParameterError(f"controller voltage of '{a.prefix.rstrip('/')}'", f"{v:.6g} V at t = {self.time:.6g} s",
