@@ -12,6 +12,7 @@
 from __future__ import annotations
 
 import functools
+import glob
 import inspect
 import os
 import secrets
@@ -26,8 +27,8 @@ _held: dict = {}                       # real path -> [(pid, thread), count, fd]
 _held_lock = threading.Lock()
 
 
-def _lock_file(path: Path, name: str, holder: str) -> int:
-    """An exclusive flock on ``path``.lock (its fd), or ParameterError naming ``path``."""
+def _lock_file(path: Path, name: str, holder: str, given) -> int:
+    """An exclusive flock on ``path``.lock (its fd), or ParameterError naming the ``given`` path."""
     try:
         import fcntl
     except ImportError:  # pragma: no cover - not POSIX: no lock, as the sweep before
@@ -40,7 +41,7 @@ def _lock_file(path: Path, name: str, holder: str) -> int:
         except OSError:
             other = os.read(fd, 200).decode(errors="replace").strip()
             os.close(fd)
-            raise ParameterError(name, str(path), f"a file no other {holder} is writing",
+            raise ParameterError(name, str(given), f"a file no other {holder} is writing",
                                  f"another {other or holder} holds its lock ({lock}): refused, not waiting; "
                                  "let it finish or choose another path") from None
         try:
@@ -69,7 +70,7 @@ def hold(path, name: str = "path", holder: str = "mjeap run"):
         if entry is not None and entry[0] == me:
             entry[1] += 1
         else:                                          # none here (or one inherited through fork)
-            entry = _held[key] = [me, 1, _lock_file(key, name, holder)]
+            entry = _held[key] = [me, 1, _lock_file(key, name, holder, path)]
     try:
         yield key
     finally:
@@ -141,11 +142,14 @@ def replacing(path, name: str = "path"):
     """A temporary path beside ``path`` (same suffix) for the block to write, renamed onto
     ``path`` when the block ends, fsynced first. A block that raises still puts what it
     wrote in place (a partial output is kept; the error says so); one that wrote nothing
-    leaves ``path`` as it was. The path's lock is held meanwhile (:func:`hold`) and SIGINT
-    and SIGTERM are delivered after the rename."""
+    leaves ``path`` as it was. The path's lock is held meanwhile (:func:`hold`), SIGINT
+    and SIGTERM are delivered after the rename, and temporaries of a writer killed mid-write
+    are removed."""
     target = Path(os.path.realpath(path))
     target.parent.mkdir(parents=True, exist_ok=True)
     with hold(target, name), deferred_signals():
+        for stale in target.parent.glob(glob.escape(f".{target.name}.") + "*" + glob.escape(f".tmp{target.suffix}")):
+            stale.unlink()                          # left by a writer killed mid-write (we hold the lock)
         tmp = target.with_name(f".{target.name}.{secrets.token_hex(4)}.tmp{target.suffix}")
         ok = False
         try:

@@ -105,6 +105,27 @@ def test_sigterm_stops_every_stepping_loop_and_its_outputs_are_written(tmp_path,
     assert _leftovers(tmp_path, {"r.rrd", "r.csv"}) == []            # no temporary or lock file
 
 
+def test_sigterm_while_the_outputs_are_written_waits_for_them(tmp_path):
+    """A stop that comes while the files are written is taken once they are complete."""
+    rrd, csv_path = tmp_path / "r.rrd", tmp_path / "r.csv"
+    code = ("import time\nfrom mjeap import Scene, recording, rollout\n"
+            "log = recording._log_outcome\n"
+            "def slow(*a, **k):\n    print('ready', flush=True)\n    time.sleep(2)\n    return log(*a, **k)\n"
+            "recording._log_outcome = slow\n"
+            f"rollout(Scene('pedot-micro'), 'step:1V', 0.05, rrd={str(rrd)!r}, csv_path={str(csv_path)!r})\n"
+            "print('not stopped', flush=True)\n")
+    p = subprocess.Popen([sys.executable, "-c", code], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                         env=ENV)
+    assert p.stdout.readline().strip() == "ready"
+    p.send_signal(signal.SIGTERM)
+    out, err = p.communicate(timeout=60)
+    assert p.returncode not in (0, -signal.SIGTERM) and "Terminated" in err and "not stopped" not in out
+    assert "/plots/voltage" in read_recording(rrd)
+    rows = list(csv.reader(open(csv_path, newline="")))
+    assert len(rows) > 10 and all(len(r) == len(rows[0]) for r in rows)
+    assert _leftovers(tmp_path, {"r.rrd", "r.csv"}) == []
+
+
 # ---------------------------------------------------------------- 2. one writer, whole files
 def test_a_second_writer_of_an_output_is_refused_before_any_work(tmp_path, monkeypatch):
     rrd, csv_path = tmp_path / "r.rrd", tmp_path / "r.csv"
