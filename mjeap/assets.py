@@ -65,10 +65,12 @@ def iter_assets() -> Iterator[Tuple[str, str]]:
 
 
 def write_assets(directory: Path = ASSET_DIR) -> Dict[str, Path]:
+    from .outputs import replacing
     directory.mkdir(parents=True, exist_ok=True)
     out = {}
     for aid, rep in iter_assets():
         p = directory / asset_name(aid, rep)
-        p.write_text(asset_xml(aid, rep))
+        with replacing(p) as tmp:
+            tmp.write_text(asset_xml(aid, rep))
         out[p.name] = p
     return out

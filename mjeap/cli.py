@@ -116,8 +116,9 @@ def cmd_mjcf(args) -> int:
     if args.output in (None, "-"):
         sys.stdout.write(xml)
     else:
-        Path(args.output).parent.mkdir(parents=True, exist_ok=True)
-        Path(args.output).write_text(xml)
+        from .outputs import replacing
+        with replacing(args.output, "--output") as tmp:
+            tmp.write_text(xml)
         c = scene.choice
         print(f"wrote {args.output}: {scene.representation}, {scene.layout.segments} segments, "
               f"timestep {c.timestep:.3g} s ({c.reason})", file=sys.stderr)

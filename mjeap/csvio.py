@@ -1,13 +1,65 @@
-"""Reading users' CSV files the way they save them: UTF-8 with or without a byte-order mark,
-Windows code pages (Latin-1), ',', ';' or tab as the delimiter (sniffed), with errors that
-say what is wrong. Serves ``mjeap identify`` and ``csv:`` waveforms."""
+"""CSV files: reading users' files the way they save them (UTF-8 with or without a
+byte-order mark, Windows code pages (Latin-1), ',', ';' or tab as the delimiter, sniffed),
+with errors that say what is wrong, for ``mjeap identify`` and ``csv:`` waveforms; and the
+one writer of mjeap's own CSVs (:class:`writer`), safe to open in a spreadsheet.
+
+Spreadsheets run a cell that begins with ``=``, ``+``, ``-``, ``@``, a tab or a carriage
+return as a formula (CSV injection: a sweep value ``=1+1``, a signal's name). The writer
+prefixes such a text cell with ``'`` (OWASP's advice, as spreadsheet-safe writers do);
+numbers, and text that reads as one (-1.5), are written unchanged. :func:`plain_cell` undoes
+it, and the readers here apply it.
+"""
 from __future__ import annotations
 
 import csv
+import numbers
+import re
 from pathlib import Path
 from typing import List
 
+import numpy as np
+
 from .errors import ParameterError
+
+#: text a spreadsheet runs as a formula: one of these first, after any quotes (so that the
+#: quote added to it reads back unambiguously)
+_FORMULA = re.compile(r"'*[=+\-@\t\r]")
+_NUMBER = re.compile(r"[+-]?(\d+\.?\d*|\.\d+)([eE][+-]?\d+)?|[+-]?(inf|infinity|nan)", re.IGNORECASE)
+
+
+def safe_cell(value):
+    """``value`` as mjeap writes it to a CSV: text a spreadsheet would run as a formula gets
+    a leading ``'``; numbers (and None, an empty cell) and other text are unchanged."""
+    if value is None or isinstance(value, numbers.Number):
+        return value
+    text = str(value)
+    return "'" + text if _FORMULA.match(text) and not _NUMBER.fullmatch(text) else value
+
+
+def plain_cell(text):
+    """A cell as read from a CSV written by :func:`safe_cell`, back to its text (anything
+    but text is returned as it is)."""
+    if isinstance(text, str) and text[:1] == "'" and safe_cell(text[1:]) != text[1:]:
+        return text[1:]
+    return text
+
+
+class writer:
+    """``csv.writer`` over ``fh`` whose cells go through :func:`safe_cell`: every CSV mjeap
+    writes is written with it."""
+
+    def __init__(self, fh, **kwargs):
+        self._w = csv.writer(fh, **kwargs)
+
+    def writerow(self, row) -> None:
+        self._w.writerow([safe_cell(c) for c in row])
+
+    def writerows(self, rows) -> None:
+        if isinstance(rows, np.ndarray) and rows.dtype.kind in "biuf":
+            self._w.writerows(rows.tolist())          # numbers only: nothing to neutralise
+            return
+        for row in rows:
+            self.writerow(row)
 
 
 def read_rows(path, what: str = "data file") -> List[List[str]]:
@@ -30,7 +82,7 @@ def read_rows(path, what: str = "data file") -> List[List[str]]:
         delimiter = dialect.delimiter
     except csv.Error:
         delimiter = ","
-    return [row for row in csv.reader(text.splitlines(), delimiter=delimiter) if row]
+    return [[plain_cell(c) for c in row] for row in csv.reader(text.splitlines(), delimiter=delimiter) if row]
 
 
 def number(cell: str, what: str, line: int) -> float:

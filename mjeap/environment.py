@@ -30,6 +30,7 @@ from . import install_mujoco_warnings
 from .discretize import Payload
 from .drives import make_drive
 from .errors import ParameterError, check_positive, check_range
+from .outputs import guarded
 from .rollout import check_initial_curvature, one_voltage
 from .scene import Scene
 
@@ -200,15 +201,16 @@ def make_environment(actuator: str = "pedot-micro", reference: Optional[Callable
     return control.Environment(physics, task, time_limit=time_limit, n_sub_steps=n_sub)
 
 
+@guarded("rrd")
 def run_episode(env: control.Environment, policy: Callable, rrd=None):
     """Run one episode of ``env`` with ``policy(time_step) -> action`` and return it as a
     :class:`mjeap.RolloutResult` sampled at every agent step (the reward and the action as
-    signals), written to ``rrd`` if given (also when the episode fails)."""
+    signals), written to ``rrd`` if given (also when the episode fails or is stopped, by
+    Ctrl-C or SIGTERM; a second writer of it is refused, :func:`mjeap.outputs.guarded`)."""
     from .analytical import arc_curvature
     from .recording import write_recording
-    from .rollout import RolloutResult, check_outputs, write_outputs
+    from .rollout import RolloutResult, write_outputs
 
-    check_outputs(rrd=rrd)
     physics, task = env.physics, env.task
     sc = physics.scene
     rows, error = [], None

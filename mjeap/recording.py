@@ -31,6 +31,8 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from .outputs import replacing
+
 MAX_FRAMES = 2000
 #: deflection / L below which the 3D view magnifies the deformation
 SMALL_DEFLECTION = 0.01
@@ -165,14 +167,19 @@ def _log_outcome(rec, meta: dict, t, extra) -> None:
 
 
 def write_recording(path, result, scene, extra=None, views=(), deformation: float = None) -> Path:
-    """Write ``result`` of a rollout of ``scene`` to ``path`` (.rrd); the file is flushed
-    and closed before returning, also for a failed (partial) run. ``extra(rec)`` may log
+    """Write ``result`` of a rollout of ``scene`` to ``path`` (.rrd); the file is flushed,
+    closed and renamed into place whole (:func:`mjeap.outputs.replacing`) before returning,
+    also for a failed (partial) run. ``extra(rec)`` may log
     more entities to the open ``rerun.RecordingStream``; ``views`` (rerun blueprint views)
     are added to the default layout for them. ``deformation``: displayed deformation scale
     of the 3D view (default: automatic, see the module)."""
+    with replacing(path, "rrd") as tmp:
+        _write_recording(tmp, result, scene, extra, views, deformation)
+    return Path(path)
+
+
+def _write_recording(path, result, scene, extra, views, deformation) -> None:
     import rerun as rr
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     L = scene.layout.length
     scale = deformation_scale(result, L) if deformation is None else float(deformation)
     bar = scale_bar_length(L)
@@ -240,7 +247,6 @@ def write_recording(path, result, scene, extra=None, views=(), deformation: floa
     finally:
         rec.flush()
         rec.disconnect()
-    return path
 
 
 def read_recording(path) -> dict:
@@ -303,11 +309,16 @@ def write_system_recording(path, result, system, extra=None, views=()) -> Path:
     ellipsoids, capsules, cylinders) moving with their bodies, and per actuator its voltage
     and tip curvature; the net contact force on every body that touches something.
     ``extra(rec)`` may log more entities to the open ``rerun.RecordingStream``; ``views``
-    (rerun blueprint views) are placed first in the plots' column for them."""
+    (rerun blueprint views) are placed first in the plots' column for them. Written whole
+    (:func:`mjeap.outputs.replacing`)."""
+    with replacing(path, "rrd") as tmp:
+        _write_system_recording(tmp, result, system, extra, views)
+    return Path(path)
+
+
+def _write_system_recording(path, result, system, extra, views) -> None:
     import rerun as rr
     import rerun.blueprint as rrb
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
     m, L = system.model, system.units.length
     names = [a.prefix.rstrip("/") for a in system.actuators]
     res = result.actuators
@@ -388,7 +399,6 @@ def write_system_recording(path, result, system, extra=None, views=()) -> Path:
     finally:
         rec.flush()
         rec.disconnect()
-    return path
 
 
 def _quat_mat(q) -> np.ndarray:

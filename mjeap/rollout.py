@@ -17,7 +17,6 @@ evaluated for all steps up front (vectorised).
 """
 from __future__ import annotations
 
-import csv
 import math
 import os
 import sys
@@ -29,8 +28,10 @@ from typing import Dict, List, Optional, Sequence, Tuple, Union
 import mujoco
 import numpy as np
 
+from . import csvio
 from .analytical import arc_curvature
-from .errors import DivergenceError, ParameterError, check_positive, check_range, sigterm_as_interrupt
+from .errors import DivergenceError, ParameterError, check_positive, check_range
+from .outputs import deferred_signals, guarded, replacing
 from .scene import Scene
 from .waveforms import Waveform, parse_waveform
 
@@ -70,16 +71,16 @@ class RolloutResult:
         return float(np.max(y[sel]) - np.min(y[sel]))
 
     def to_csv(self, path: Union[str, Path]) -> None:
-        """Time series (no centreline) as CSV with SI units in the header."""
+        """Time series (no centreline) as CSV with SI units in the header, written whole
+        (:func:`mjeap.outputs.replacing`) and spreadsheet-safe (:class:`mjeap.csvio.writer`)."""
         cols = {"time (s)": self.time, "voltage (V)": self.voltage,
                 "tip_x (m)": self.tip_position[:, 0], "tip_y (m)": self.tip_position[:, 1],
                 "tip_z (m)": self.tip_position[:, 2], "tip_angle (rad)": self.tip_angle,
                 "tip_curvature (1/m)": self.tip_curvature, **self.signals}
         if self.reference_curvature is not None:
             cols["reference_curvature (1/m)"] = self.reference_curvature
-        Path(path).parent.mkdir(parents=True, exist_ok=True)
-        with open(path, "w", newline="") as fh:
-            w = csv.writer(fh)
+        with replacing(path, "csv_path") as tmp, open(tmp, "w", newline="") as fh:
+            w = csvio.writer(fh)
             w.writerow(cols)
             w.writerows(np.column_stack([np.asarray(c, dtype=float) for c in cols.values()]))
 
@@ -225,14 +226,16 @@ def check_outputs(**paths) -> Dict[str, Path]:
 def write_outputs(writers, error: Optional[BaseException], result=None) -> None:
     """Run each ``(path, write)`` on its own: one failing write does not stop the others.
     The run's own error stays the error raised (the write failures are added to its notes);
-    without one, the failures raise :class:`OutputError` carrying the result."""
+    without one, the failures raise :class:`OutputError` carrying the result. Ctrl-C and
+    SIGTERM wait until all are written."""
     from .errors import OutputError
     failures = []
-    for path, write in writers:
-        try:
-            write()
-        except Exception as e:                       # noqa: BLE001 - reported, never masks the run's error
-            failures.append((path, f"{type(e).__name__}: {e}"))
+    with deferred_signals():
+        for path, write in writers:
+            try:
+                write()
+            except Exception as e:                   # noqa: BLE001 - reported, never masks the run's error
+                failures.append((path, f"{type(e).__name__}: {e}"))
     if not failures:
         return
     if error is not None:
@@ -331,6 +334,7 @@ def _choose_engine(engine: str, scene, drv, controller) -> Tuple[str, str]:
     return "loop", "; ".join(["auto"] + [f"not {x}: {w}" for x, w in why.items()])
 
 
+@guarded("rrd", "csv_path")
 def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: float,
             drive: Union[str, "object", None] = None, drive_params: Optional[dict] = None,
             initial_curvature: float = 0.0, rrd: Union[str, Path, None] = None,
@@ -343,8 +347,9 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     The beam starts at rest as a uniform arc of ``initial_curvature`` (1/m). Returns SI
     arrays sampled every ``sample_interval`` s (default: at most 5001 evenly spaced samples, the
     initial state included; the scene is left in the final state). With
-    ``rrd`` a Rerun recording is written (also when the run fails: it then ends with the
-    error), with ``csv_path`` the time series as CSV. A diverging run raises
+    ``rrd`` a Rerun recording is written (also when the run fails or is stopped by Ctrl-C or
+    SIGTERM: it then ends with the error), with ``csv_path`` the time series as CSV; a
+    second writer of either is refused (:func:`mjeap.outputs.guarded`). A diverging run raises
     :class:`DivergenceError` naming the step, the drive and the timestep. ``engine``:
     'loop', 'threaded' (open-loop drives only, see the module) or 'auto'. Refused before
     any work: a duration shorter than a step, more than ``max_steps`` steps (default
@@ -354,7 +359,6 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     from . import recording, threaded
 
     duration = check_positive("duration", duration, "s")
-    check_outputs(rrd=rrd, csv_path=csv_path)
     initial_curvature = check_initial_curvature(initial_curvature, scene.layout.length)
     wave = None if controller is not None else _waveform(voltage, duration)
     drv = drive if (drive is not None and not isinstance(drive, str)) else \
@@ -378,15 +382,14 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     error = None
     wall0 = _time.perf_counter()
     try:
-        with sigterm_as_interrupt():   # SIGTERM ends the run as Ctrl-C does: what was simulated is written
-            if engine == "threaded":
-                threaded.run(scene, [drv], [v_steps], [initial_curvature], sample_steps, [samples], nthread=0)
-            elif engine == "native":
-                threaded.run_native(scene, nat, [drv], [v_steps], [initial_curvature], sample_steps, [samples],
-                                    nthread=0)
-            else:
-                _run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, progress, check_every,
-                          controller, meta)
+        if engine == "threaded":
+            threaded.run(scene, [drv], [v_steps], [initial_curvature], sample_steps, [samples], nthread=0)
+        elif engine == "native":
+            threaded.run_native(scene, nat, [drv], [v_steps], [initial_curvature], sample_steps, [samples],
+                                nthread=0)
+        else:
+            _run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, progress, check_every,
+                      controller, meta)
     except BaseException as e:  # record what was simulated, then re-raise
         error = e
         raise

@@ -30,7 +30,10 @@ from typing import Callable, Dict, Iterable, List, Optional, Sequence
 
 import numpy as np
 
+from . import csvio
+from .csvio import plain_cell
 from .errors import DivergenceError, MjeapError, ParameterError, UnknownNameError, sigterm_as_interrupt
+from .outputs import hold
 
 EXECUTORS = ("processes", "serial", "dask")
 
@@ -245,9 +248,11 @@ def _drop_torn_row(path: Path) -> None:
 
 
 def read_results(path) -> List[dict]:
-    """Rows of a sweep CSV (strings; the header names the columns)."""
+    """Rows of a sweep CSV (strings, as given: the quote that keeps a spreadsheet from
+    running a text cell as a formula is dropped, :mod:`mjeap.csvio`; the header names the
+    columns)."""
     with open(path, newline="") as fh:
-        return list(csv.DictReader(fh))
+        return [{plain_cell(k): plain_cell(v) for k, v in row.items()} for row in csv.DictReader(fh)]
 
 
 def _die_with_parent() -> None:
@@ -385,28 +390,10 @@ def run_sweep(points: Sequence[dict], path, metrics: Sequence[str] = ("peak_to_p
         _check_names(p)
     check_settings(points, base)
     path.parent.mkdir(parents=True, exist_ok=True)
-    lock = _lock(path)
-    try:
+    # the CSV's lock for the whole sweep (PATH.lock): a second sweep on it, or a run writing it,
+    # is refused (it would compute every point twice and duplicate rows)
+    with hold(path, "path", holder="mjeap sweep"):
         return _run_locked(points, path, metrics, base, executor, workers, scheduler, record, rrd_dir, progress)
-    finally:
-        lock.close()
-
-
-def _lock(path: Path):
-    """An exclusive lock on ``path``.lock for the whole sweep: a second sweep on the same CSV
-    is refused (it would compute every point twice and duplicate rows)."""
-    fh = open(path.with_name(path.name + ".lock"), "a+")
-    try:
-        import fcntl
-        fcntl.flock(fh, fcntl.LOCK_EX | fcntl.LOCK_NB)
-    except ImportError:  # pragma: no cover - not POSIX
-        pass
-    except OSError:
-        fh.close()
-        raise ParameterError("path", str(path), "a CSV that no other sweep is writing",
-                             "another mjeap sweep holds its lock: refused, not waiting; let it finish or choose "
-                             "another --out") from None
-    return fh
 
 
 def _run_locked(points, path, metrics, base, executor, workers, scheduler, record, rrd_dir, progress):
@@ -424,7 +411,7 @@ def _run_locked(points, path, metrics, base, executor, workers, scheduler, recor
     new_file = not path.exists() or path.stat().st_size == 0
     if not new_file:
         with open(path, newline="") as fh:
-            header = next(csv.reader(fh))
+            header = [plain_cell(c) for c in next(csv.reader(fh))]
         if header != columns:
             raise ParameterError("path", str(path), f"a CSV of this sweep (columns {columns}); it has {header}")
     bar = None
@@ -442,13 +429,13 @@ def _run_locked(points, path, metrics, base, executor, workers, scheduler, recor
 def _write_rows(path, columns, new_file, executor, workers, scheduler, jobs, bar, skipped, t0):
     failed, done = 0, 0
     with open(path, "a", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=columns)
+        w = csvio.writer(fh)
         if new_file:
-            w.writeheader()
+            w.writerow(columns)
             fh.flush()
         try:
             for row in _submit_all(executor, int(workers), scheduler, jobs):
-                w.writerow({k: row.get(k, "") for k in columns})
+                w.writerow([row.get(k, "") for k in columns])
                 fh.flush()
                 os.fsync(fh.fileno())
                 done += 1

@@ -31,6 +31,7 @@ import numpy as np
 from . import native
 from .component import ActuatorPart
 from .errors import DivergenceError, ParameterError, UnknownNameError, check_positive
+from .outputs import guarded
 from .rollout import one_voltage
 from .scene import DEFAULT_SEGMENTS, INTEGRATORS, Scene, apply_dof_damping, diverged
 from .units import DEFAULT_UNITS, UnitSystem
@@ -546,22 +547,22 @@ class System:
             vs[k] = v
 
     # ------------------------------------------------------------------ rollout
+    @guarded("rrd")
     def rollout(self, voltages, duration: float, initial_curvatures: Union[float, Sequence[float]] = 0.0,
                 sample_interval: Optional[float] = None, rrd: Union[str, Path, None] = None,
                 on_sample=None, controller=None) -> SystemResult:
         """Run for ``duration`` s with one voltage per actuator (waveform text,
         :class:`~mjeap.Waveform`, callable v(t) or None for its rest voltage; a list or a dict
         by prefix). Returns a :class:`SystemResult`; with ``rrd`` a Rerun recording (written
-        also when the run fails: it then ends with the error). ``on_sample(system)`` is
-        called at every sample (e.g. to move a mocap body). ``controller(t, system)``
+        also when the run fails or is stopped by Ctrl-C or SIGTERM: it then ends with the
+        error; a second writer is refused, :func:`mjeap.outputs.guarded`). ``on_sample(system)``
+        is called at every sample (e.g. to move a mocap body). ``controller(t, system)``
         (``voltages`` then None) is called before every step and returns the voltages (V) to
         hold over it, one per actuator or a dict by prefix (None: unchanged); each is checked
         against its drive's safe range. It may read the system's state; a controller that
         senses an actuator's current steps a :meth:`drive_observer` with them."""
-        from .rollout import (_Samples, _sample_steps, _voltage_steps, _waveform, check_outputs, check_work,
-                              write_outputs)
+        from .rollout import _Samples, _sample_steps, _voltage_steps, _waveform, check_work, write_outputs
         duration = check_positive("duration", duration, "s")
-        check_outputs(rrd=rrd)
         if controller is not None:
             if voltages is not None and any(v is not None for v in self._per_actuator("voltages", voltages)):
                 raise ParameterError("voltages", voltages, "None when a controller sets the voltages")

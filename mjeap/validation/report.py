@@ -10,6 +10,7 @@ from typing import Optional, List
 
 import numpy as np
 
+from ..outputs import replacing
 from .core import REFERENCE_KINDS, Experiment
 
 #: beam frames per simulated run in an experiment's recording
@@ -55,7 +56,8 @@ def write_json(experiments: List[Experiment], path: Path) -> None:
     doc = {"passed": all(e.passed for e in experiments),
            "experiments": [{"name": e.name, "title": e.title, "seconds": round(e.seconds, 2), "passed": e.passed,
                             "notes": e.notes, "checks": [c.as_dict() for c in e.checks]} for e in experiments]}
-    path.write_text(json.dumps(doc, indent=1, default=float))
+    with replacing(path) as tmp:
+        tmp.write_text(json.dumps(doc, indent=1, default=float))
 
 
 def have_matplotlib() -> bool:
@@ -88,7 +90,8 @@ def write_figure(ex: Experiment, path: Path) -> None:
         ax.set_visible(False)
     fig.suptitle(ex.title, fontsize=11)
     fig.tight_layout()
-    fig.savefig(path, dpi=110)
+    with replacing(path) as tmp:
+        fig.savefig(tmp, dpi=110, format=Path(path).suffix[1:] or "png")
     plt.close(fig)
 
 
@@ -96,7 +99,13 @@ def write_recording(ex: Experiment, path: Path, figure: Optional[Path] = None) -
     """The experiment as a Rerun recording laid out for review: the checks (verdict first),
     curves against time as time series with fitted y axes, the report's figure as an image
     (``figure``: its PNG; curves against other quantities are best read there, with axes and
-    units), without matplotlib those curves as a table, and the simulated beams in 3D."""
+    units), without matplotlib those curves as a table, and the simulated beams in 3D.
+    Written whole (:func:`mjeap.outputs.replacing`)."""
+    with replacing(path, "rrd") as tmp:
+        _write_recording(ex, tmp, figure)
+
+
+def _write_recording(ex: Experiment, path: Path, figure: Optional[Path]) -> None:
     import rerun as rr
     import rerun.blueprint as rrb
     from ..recording import deformation_scale, y_axis
@@ -202,4 +211,5 @@ def write_markdown(experiments: List[Experiment], path: Path, figures: bool) -> 
             ""]
     if not figures:
         head += ["(Figures need matplotlib: `pip install -e '.[report]'`.)", ""]
-    path.write_text("\n".join(head) + "\n" + "\n".join(markdown_section(e, figures) for e in experiments))
+    with replacing(path) as tmp:
+        tmp.write_text("\n".join(head) + "\n" + "\n".join(markdown_section(e, figures) for e in experiments))
