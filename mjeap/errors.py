@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 import difflib
-from typing import Iterable
+from typing import Iterable, Optional
 
 
 class MjeapError(Exception):
@@ -25,7 +25,7 @@ class ParameterError(MjeapError, ValueError):
     """
 
     def __init__(self, name: str, value, accepted: str, why: str = ""):
-        self.name, self.value, self.accepted = name, value, accepted
+        self.name, self.value, self.accepted, self.why = name, value, accepted, why
         msg = f"{name}={value!r} is not accepted: expected {accepted}"
         if why:
             msg += f" ({why})"
@@ -67,13 +67,30 @@ def check_positive(name: str, value: float, unit: str = "") -> float:
 def check_range(name: str, value: float, lo: float, hi: float, unit: str = "",
                 lo_open: bool = False, hi_open: bool = False) -> float:
     """Return ``float(value)`` if it lies in the interval, else raise ParameterError."""
-    v = float(value)
+    interval = f"{'(' if lo_open else '['}{lo:.6g}, {hi:.6g}{')' if hi_open else ']'}"
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ParameterError(name, value, f"a number in {interval}{(' ' + unit) if unit else ''}") from None
     ok_lo = v > lo if lo_open else v >= lo
     ok_hi = v < hi if hi_open else v <= hi
     if not (ok_lo and ok_hi) or v != v:
-        interval = f"{'(' if lo_open else '['}{lo:.6g}, {hi:.6g}{')' if hi_open else ']'}"
         raise ParameterError(name, value, f"a value in {interval}{(' ' + unit) if unit else ''}")
     return v
+
+
+def check_integer(name: str, value, lo: int, hi: Optional[int] = None, why: str = "") -> int:
+    """Return ``int(value)`` if it is a whole number in [lo, hi] (hi None: no upper bound),
+    else raise ParameterError naming the range (a bool, 2.5 or '2.5' is refused)."""
+    accepted = f"an integer in [{lo}, {hi}]" if hi is not None else f"an integer >= {lo}"
+    try:
+        v = value if isinstance(value, (int, float)) else float(str(value).strip())
+        ok = not isinstance(value, bool) and float(v) == int(v)
+    except (TypeError, ValueError, OverflowError):
+        ok = False
+    if not ok or int(v) < lo or (hi is not None and int(v) > hi):
+        raise ParameterError(name, value, accepted, why)
+    return int(v)
 
 
 class Terminated(KeyboardInterrupt):
@@ -83,13 +100,19 @@ class Terminated(KeyboardInterrupt):
 class sigterm_as_interrupt:
     """Context manager: within it (in the main thread) SIGTERM raises :class:`Terminated`,
     a KeyboardInterrupt, so a run or a sweep ends as after Ctrl-C; the previous handler is
-    restored on exit. Elsewhere (another thread) it does nothing."""
+    restored on exit. Elsewhere (another thread, or a pool worker whose parent stops it:
+    ``in_pool_worker``, set by :func:`mjeap.sweep.worker_signals`) it does nothing: a
+    worker asked to stop by its parent stops at once, it does not finish its point (nor
+    hold its task queue's lock while the parent waits for it)."""
+
+    #: True in a process-pool worker (SIGTERM keeps its default action there)
+    in_pool_worker = False
 
     def __enter__(self):
         import signal
         import threading
         self._old = None
-        if threading.current_thread() is threading.main_thread():
+        if threading.current_thread() is threading.main_thread() and not sigterm_as_interrupt.in_pool_worker:
             def handler(signum, frame):
                 raise Terminated()
             self._old = signal.signal(signal.SIGTERM, handler)

@@ -30,7 +30,7 @@ import numpy as np
 
 from . import csvio
 from .analytical import arc_curvature
-from .errors import DivergenceError, ParameterError, check_positive, check_range
+from .errors import DivergenceError, ParameterError, check_integer, check_positive, check_range
 from .outputs import deferred_signals, guarded, replacing
 from .scene import Scene
 from .waveforms import Waveform, parse_waveform
@@ -274,17 +274,23 @@ def _waveform(voltage, duration: float):
 
 
 def one_voltage(value, name: str, where: str = "") -> float:
-    """A policy's or controller's command for one actuator as a voltage (V): a number or a
-    one-element array (shape (1,), a dm_env action); more values (two for one actuator),
-    none or text are refused naming the shape expected, never cut to the first."""
-    accepted = "one voltage in V for one actuator: a number or an array of shape (1,)"
+    """A policy's or controller's command for one actuator as a voltage (V): a finite real
+    number or a one-element array (shape (1,), a dm_env action). Text, None, a bool, more
+    values (two for one actuator, never cut to the first), none or NaN/inf are refused
+    naming ``name``, the shape expected and ``where`` (the controller and time). The one
+    check of every command path (:func:`rollout`'s loop, :class:`mjeap.system.System`,
+    the dm_env environment)."""
     try:
-        a = np.asarray(value, dtype=float)
-    except (TypeError, ValueError):
-        raise ParameterError(name, value, accepted, where) from None
-    if a.size != 1:
-        raise ParameterError(name, f"{value!r} (shape {a.shape})", accepted, where)
-    return float(a.reshape(-1)[0])
+        a = None if isinstance(value, (str, bytes, bool, type(None))) else np.asarray(value)
+    except (TypeError, ValueError):          # ragged nesting
+        a = None
+    ok = a is not None and a.size == 1 and a.dtype.kind in "iuf"
+    v = float(a.reshape(-1)[0]) if ok else math.nan
+    if not math.isfinite(v):
+        shown = value if ok or a is None or a.ndim == 0 else f"{type(value).__name__} of shape {a.shape}"
+        raise ParameterError(name, shown, "one number, a finite voltage in V for one actuator (a number or an "
+                             "array of shape (1,))", where)
+    return v
 
 
 #: the largest initial bend accepted: a uniform arc closing into a full circle
@@ -439,11 +445,8 @@ def _run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, pro
                 if k % ctrl_every == 0:
                     scene.update_kinematics()
                     u = controller(k * dt, scene)
-                    if not isinstance(u, float):
+                    if not isinstance(u, float) or not math.isfinite(u):
                         u = one_voltage(u, "controller command", f"{ctrl_name} at t = {k * dt:.6g} s")
-                    if not math.isfinite(u):     # not a clipping case: name who and when
-                        raise ParameterError("controller command", u, "a finite voltage",
-                                             f"{ctrl_name} at t = {k * dt:.6g} s")
                     v_hold = min(max(u, v_lo), v_hi)
                     saturated += v_hold != u
                 v_steps[k] = v_hold
@@ -493,28 +496,34 @@ def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable
                   engine: str = "auto") -> List[RolloutResult]:
     """Many rollouts of one scene, one per entry of ``voltages`` (and of
     ``initial_curvatures``, 1/m, a scalar for all; a single waveform runs once per initial
-    curvature, or once), on MuJoCo's threaded rollout with
-    ``nthread`` threads (default: one per CPU): the drive compiled into the model
-    (``native``) or its moment history as applied forces (``threaded``); ``auto`` takes
-    the first that applies. Same results as :func:`rollout` run one by one with that
+    curvature, or once), on MuJoCo's threaded rollout with ``nthread`` threads (1 to the
+    number of CPUs; default: one per CPU): the drive compiled into the model (``native``)
+    or its moment history as applied forces (``threaded``); ``auto`` takes the first that
+    applies. Same results as :func:`rollout` run one by one with that
     engine; raises ParameterError where neither applies."""
-    import os
     from .drives import make_drive
     from . import threaded
 
     duration = check_positive("duration", duration, "s")
-    k0 = np.asarray(initial_curvatures, dtype=float)
-    if isinstance(voltages, (str, int, float)) or callable(voltages):   # one waveform, not its characters
-        voltages = [voltages] * (k0.size if k0.ndim == 1 else 1)
+    if np.ndim(initial_curvatures) == 0:
+        kappa0 = None
+    else:
+        kappa0 = list(np.ravel(initial_curvatures)) if np.ndim(initial_curvatures) == 1 else []
+    if isinstance(voltages, (str, int, float, Waveform)) or callable(voltages):   # one waveform, not its characters
+        voltages = [voltages] * (len(kappa0) if kappa0 else 1)
     voltages = list(voltages)
     if not voltages:
         raise ParameterError("voltages", voltages, "at least one waveform")
-    if k0.ndim > 1 or (k0.ndim == 1 and k0.size != len(voltages)):
-        raise ParameterError("initial_curvatures", f"{k0.size} values (shape {k0.shape})",
-                             f"one number for every run, or one per run ({len(voltages)} voltages)")
-    kappa0 = np.broadcast_to(k0, (len(voltages),))
-    for k in kappa0:
-        check_initial_curvature(k, scene.layout.length, "initial_curvatures")
+    cpus = os.cpu_count() or 1
+    nthread = cpus if nthread is None else check_integer("nthread", nthread, 1, cpus,
+                                                         f"{cpus} CPUs here: more threads only contend")
+    if kappa0 is None:
+        kappa0 = [initial_curvatures] * len(voltages)
+    elif np.ndim(initial_curvatures) != 1 or len(kappa0) != len(voltages):
+        raise ParameterError("initial_curvatures", f"{len(kappa0)} values" if np.ndim(initial_curvatures) == 1 else
+                             f"an array of shape {np.shape(initial_curvatures)}",
+                             f"one number (1/m) for all or one per voltage ({len(voltages)})")
+    kappa0 = [check_initial_curvature(k, scene.layout.length, "initial_curvatures") for k in kappa0]
     drives = [make_drive(drive, scene, **(drive_params or {})) for _ in voltages]
     engine, _ = _choose_engine(engine, scene, drives[0], None)
     if engine == "loop":
@@ -525,7 +534,6 @@ def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable
     sample_steps = _sample_steps(len(v_steps[0]), dt, sample_interval)
     nat = scene.native_model(drives[0]) if engine == "native" else None
     samples = [_Samples(scene.part if nat is None else nat.part, len(sample_steps)) for _ in voltages]
-    nthread = (os.cpu_count() or 1) if nthread is None else int(nthread)
     wall0 = _time.perf_counter()
     if nat is None:
         threaded.run(scene, drives, v_steps, list(kappa0), sample_steps, samples, nthread=nthread)

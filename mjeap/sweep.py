@@ -32,7 +32,8 @@ import numpy as np
 
 from . import csvio
 from .csvio import plain_cell
-from .errors import DivergenceError, MjeapError, ParameterError, UnknownNameError, sigterm_as_interrupt
+from .errors import (DivergenceError, MjeapError, ParameterError, UnknownNameError, check_integer,
+                     sigterm_as_interrupt)
 from .outputs import hold
 
 EXECUTORS = ("processes", "serial", "dask")
@@ -266,8 +267,29 @@ def _die_with_parent() -> None:
         pass
 
 
-def _worker_init() -> None:
+def worker_signals() -> None:
+    """Process-pool initializer: the worker dies with its parent (:func:`_die_with_parent`),
+    ignores Ctrl-C (the terminal sends it to the whole process group; the parent stops its
+    workers) and takes SIGTERM's default action (a forked worker inherits the parent's
+    :class:`~mjeap.errors.sigterm_as_interrupt` handler, which would print a traceback when
+    the parent terminates it)."""
+    import signal
     _die_with_parent()
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    sigterm_as_interrupt.in_pool_worker = True       # a run's guard inside the worker leaves SIGTERM alone
+
+
+def stop_workers(executor) -> None:
+    """Stop a ProcessPoolExecutor now: terminate its processes (the points in flight are
+    not waited for) and shut it down without waiting."""
+    for proc in list((getattr(executor, "_processes", None) or {}).values()):
+        proc.terminate()
+    executor.shutdown(wait=False, cancel_futures=True)
+
+
+def _worker_init() -> None:
+    worker_signals()
     _one_blas_thread()
 
 
@@ -352,9 +374,7 @@ def _run_processes(jobs: list, workers: int):
                     suspects += list(inflight.values())
                     break
         except BaseException:               # Ctrl-C, SIGTERM, the caller closing: stop the workers now
-            for proc in list(getattr(ex, "_processes", {}).values()):
-                proc.terminate()
-            ex.shutdown(wait=False, cancel_futures=True)
+            stop_workers(ex)
             raise
         else:
             ex.shutdown(wait=not suspects, cancel_futures=True)
@@ -388,6 +408,11 @@ def run_sweep(points: Sequence[dict], path, metrics: Sequence[str] = ("peak_to_p
     points = list(points)
     for p in points:
         _check_names(p)
+    if isinstance(record, (str, bytes, int)):
+        raise ParameterError("record", record, "a list of point indices, e.g. [0, 5]")
+    n = len(points)
+    record = [check_integer("record", i, 0, n - 1, f"indices of the sweep's {n} point{'s' * (n != 1)}")
+              for i in record]
     check_settings(points, base)
     path.parent.mkdir(parents=True, exist_ok=True)
     # the CSV's lock for the whole sweep (PATH.lock): a second sweep on it, or a run writing it,

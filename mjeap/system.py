@@ -170,9 +170,39 @@ def host_gravity(option, driven: bool) -> np.ndarray:
     return np.array(option.gravity, dtype=float)
 
 
+
+
+#: compiled arrays a host's elements must hold finite: (MuJoCo object, array, what it is)
+_FINITE = (("body", "body_pos", "pos"), ("body", "body_quat", "quat"), ("body", "body_ipos", "inertial pos"),
+           ("body", "body_iquat", "inertial quat"), ("body", "body_mass", "mass"), ("body", "body_inertia", "inertia"),
+           ("site", "site_pos", "pos"), ("site", "site_quat", "quat"), ("site", "site_size", "size"),
+           ("geom", "geom_pos", "pos"), ("geom", "geom_quat", "quat"), ("geom", "geom_size", "size"),
+           ("joint", "jnt_pos", "pos"), ("joint", "jnt_axis", "axis"), ("equality", "eq_data", "data"))
+
+
+def check_finite_model(model: mujoco.MjModel, what: str = "spec") -> None:
+    """Refuse a compiled host whose bodies, sites, geoms, joints or equalities hold a
+    non-finite position, orientation, size or mass, naming the element (MuJoCo compiles
+    them; the first step then diverges, which would be blamed on the timestep)."""
+    for kind, array, label in _FINITE:
+        a = np.asarray(getattr(model, array))
+        if not a.size:
+            continue
+        a = a.reshape(a.shape[0], -1)
+        bad = np.nonzero(~np.isfinite(a).all(axis=1))[0]
+        if bad.size:
+            i = int(bad[0])
+            obj = getattr(mujoco.mjtObj, f"mjOBJ_{'EQUALITY' if kind == 'equality' else kind.upper()}")
+            name = mujoco.mj_id2name(model, obj, i) or f"#{i} (unnamed)"
+            raise ParameterError(f"{what}: {kind} '{name}' {label}", a[i].tolist(), "finite numbers",
+                                 "a NaN or inf in the host model, not a timestep problem")
+
+
 def _mount_rotation(spec: mujoco.MjSpec, kind: str, name: str, el) -> np.ndarray:
-    """World rotation of the mount at the host's qpos0."""
+    """World rotation of the mount at the host's qpos0; a host with non-finite positions
+    is refused (:func:`check_finite_model`)."""
     m = spec.copy().compile()
+    check_finite_model(m)
     d = mujoco.MjData(m)
     mujoco.mj_kinematics(m, d)
     if kind == "site":
@@ -382,6 +412,7 @@ class System:
             raise ParameterError("spec", spec.modelname, "a host model that compiles with its actuators",
                                  str(e).splitlines()[0]) from None
         self.model = apply_dof_damping(model)         # a cable's per-dof damping (PREFIX/mjeap_dof_damping)
+        check_finite_model(self.model)
         self.data = mujoco.MjData(self.model)
         m = self.model
         self.parts: List[ActuatorPart] = []
@@ -529,17 +560,29 @@ class System:
         dist = [d.contact[i].dist for i in range(d.ncon)]
         return max(0.0, -min(dist, default=0.0)) * self.units.length
 
-    def _control(self, voltages, v_steps, k: int) -> None:
-        """Hold a controller's ``voltages`` (V) from step ``k`` on, each checked first."""
-        for a, vs, v in zip(self.actuators, v_steps, self._per_actuator("controller voltages", voltages)):
+    def _control(self, voltages, v_steps, k: int, who: str) -> None:
+        """Hold a controller's ``voltages`` (V) from step ``k`` on, each checked first: one
+        number per actuator (or one for all, or a dict by prefix; None: unchanged)."""
+        t = self.time
+        try:
+            if isinstance(voltages, (str, bytes)):
+                raise ValueError
+            listed = isinstance(voltages, (list, tuple)) and len(voltages) == len(self)    # checked one by one
+            values = list(voltages) if listed else self._per_actuator("controller voltages", voltages)
+        except (ParameterError, ValueError, TypeError):      # text, a wrong length, ragged
+            shown = voltages if isinstance(voltages, (str, bytes)) else \
+                f"{len(voltages)} values" if hasattr(voltages, "__len__") else type(voltages).__name__
+            raise ParameterError("controller voltages", shown, f"one number (V) for all or one per actuator "
+                                 f"({len(self)}: {', '.join(a.prefix.rstrip('/') for a in self.actuators)}), "
+                                 "or a dict by prefix", f"{who} at t = {t:.6g} s") from None
+        for a, vs, v in zip(self.actuators, v_steps, values):
             if vs is None:
                 continue
             if v is None:
                 if k:
                     vs[k] = vs[k - 1]
                 continue
-            if not isinstance(v, float):
-                v = one_voltage(v, f"controller voltage of '{a.prefix.rstrip('/')}'", f"at t = {self.time:.6g} s")
+            v = one_voltage(v, f"controller voltage of '{a.prefix.rstrip('/')}'", f"{who} at t = {t:.6g} s")
             lo, hi = a.drive.voltage_range()
             if not (lo - 1e-12 <= v <= hi + 1e-12):
                 raise ParameterError(f"controller voltage of '{a.prefix.rstrip('/')}'", f"{v:.6g} V at t = {self.time:.6g} s",
@@ -622,12 +665,12 @@ class System:
         wall0 = _time.perf_counter()
         try:
             if controller is not None:          # the voltage over step 0 is the first sample's
-                self._control(controller(0.0, self), v_steps, 0)
+                self._control(controller(0.0, self), v_steps, 0, ctrl_name)
             sample(0, 0)
             nxt = 1
             for k in range(n_steps):
                 if controller is not None and k:
-                    self._control(controller(k * dt, self), v_steps, k)
+                    self._control(controller(k * dt, self), v_steps, k, ctrl_name)
                 for i, v in active:
                     d.ctrl[i] = v[k]
                 mujoco.mj_step(m, d)

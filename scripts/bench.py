@@ -379,15 +379,17 @@ def bench_native(repeats=2, map_points=8):
 BENCHMARKS = ("models", "rollout", "drives", "threaded", "elastica", "sweep", "native")
 
 
-def main():
+def main(argv=None):
+    from mjeap.cli import arg_number, arg_output, parse_args
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--json", help="also write the results to this file")
-    ap.add_argument("--min-seconds", type=float, default=0.5, help="timing window per measurement")
+    ap.add_argument("--json", type=arg_output(), help="also write the results to this file")
+    ap.add_argument("--min-seconds", type=arg_number(0.0, float("inf"), "s", True, True), default=0.5,
+                    help="timing window per measurement (s)")
     ap.add_argument("--only", choices=BENCHMARKS, action="append", help="run these benchmarks (repeatable)")
-    ap.add_argument("--elastica-time", type=float, default=0.05,
+    ap.add_argument("--elastica-time", type=arg_number(0.0, float("inf"), "s", True, True), default=0.05,
                     help="simulated time of the elastica benchmark (s); PyElastica takes ~1 min per 0.05 s")
     ap.add_argument("--no-pyelastica", action="store_true", help="mjeap side of the elastica benchmark only")
-    args = ap.parse_args()
+    args = parse_args(ap, argv)
     only = args.only or BENCHMARKS
     out = {"machine": {"python": platform.python_version(), "mujoco": mujoco.__version__,
                        "processor": platform.processor() or platform.machine(), "cpus": os.cpu_count()}}
@@ -423,4 +425,5 @@ def main():
 
 
 if __name__ == "__main__":
-    main()
+    from mjeap.cli import run_script
+    sys.exit(run_script(main))

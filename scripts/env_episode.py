@@ -7,10 +7,12 @@ pedot-micro standing up with a payload at 6.27 mm whose mass is drawn per episod
 1-12.6 mg, initial curvature from -20..20 1/m; reference: 50 1/m at 0.05 Hz.
 """
 import argparse
+import sys
 
 import numpy as np
 
 from controllers.curvature_tracking import CurvatureTracker
+from mjeap.cli import arg_integer, arg_number, arg_output, parse_args, run_script
 from mjeap.environment import make_environment, run_episode
 
 
@@ -20,10 +22,11 @@ def reference(t):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--duration", type=float, default=20.0)
-    ap.add_argument("--out", default="out/env-episode.rrd")
-    a = ap.parse_args(argv)
+    ap.add_argument("--seed", type=arg_integer(0), default=0)
+    ap.add_argument("--duration", type=arg_number(0.01, 600.0, "s"), default=20.0,
+                    help="simulated time of the episode (s): from one agent step (10 ms) to 600 s")
+    ap.add_argument("--out", default="out/env-episode.rrd", type=arg_output(), help="recording (.rrd)")
+    a = parse_args(ap, argv)
     env = make_environment("pedot-micro", reference, payload_mass_range=(1e-6, 12.6e-6),
                            initial_curvature_range=(-20.0, 20.0), time_limit=a.duration, seed=a.seed)
     tracker = CurvatureTracker(reference, a.duration + 1.0, interval=env.control_timestep())
@@ -45,4 +48,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(run_script(main))

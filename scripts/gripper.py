@@ -46,9 +46,9 @@ from __future__ import annotations
 
 import argparse
 import json
+import sys
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field, replace
-from pathlib import Path
 from typing import Optional
 
 import mujoco
@@ -56,6 +56,9 @@ import numpy as np
 from scipy import optimize
 
 from mjeap.analytical import DadrasModel
+from mjeap.cli import arg_number, arg_output, parse_args, run_script
+from mjeap.errors import ParameterError, check_range
+from mjeap.sweep import stop_workers, worker_signals
 from mjeap.system import ContactParameters, System, attach
 
 BEAD_RADIUS = 0.75e-3         # m
@@ -310,22 +313,56 @@ def held_run(voltage: float, hold: float, out: Optional[str]) -> dict:
     }
 
 
+#: --hold (s): the early grip force is read 1 s after contact; at most 600 s (the held run,
+#: hold + 1.5 s, stays within the rollout's 20 million steps of the gripper's 38 us)
+HOLD_RANGE = (1.0, 600.0)
+
+
+def contact_voltage(hold: float) -> float:
+    """The smallest held voltage (V) at which the fingers reach the bead within ``hold`` s
+    (closed form: the free deflection at A, linear in the voltage, reaches GAP)."""
+    t = np.linspace(0.0, hold, 4001)
+    y = DadrasModel().free_curvature(t, np.ones_like(t)) * A**2 / 2      # at 1 V
+    return GAP / float(np.max(y))
+
+
+def _check_voltage(a) -> None:
+    """The held voltage: within pedot-micro's safe range, and enough to reach the bead."""
+    from mjeap.catalog import get_actuator
+    hold = 10.0 if a.quick else a.hold
+    lo, hi = contact_voltage(hold), get_actuator("pedot-micro").voltage_range[1]
+    try:
+        check_range("--voltage", a.voltage, lo, hi, "V", lo_open=True)
+    except ParameterError as e:
+        raise ParameterError("--voltage", a.voltage, e.accepted,
+                             f"at {lo:.3g} V the fingers just reach the bead in the {hold:g} s hold (closed form); "
+                             f"{hi:g} V is pedot-micro's safe limit") from None
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default="out/gripper.rrd")
-    ap.add_argument("--voltage", type=float, default=1.0, help="held voltage for the grip force (V)")
-    ap.add_argument("--hold", type=float, default=60.0, help="how long the voltage is held (s)")
+    ap.add_argument("--out", default="out/gripper.rrd", type=arg_output(), help="recording (.rrd)")
+    ap.add_argument("--voltage", type=float, default=1.0,
+                    help="held voltage for the grip force (V): above the fingers' contact voltage for the hold "
+                         "(0.066 V for 60 s), up to pedot-micro's 3 V")
+    ap.add_argument("--hold", type=arg_number(*HOLD_RANGE, "s"), default=60.0,
+                    help=f"how long the voltage is held ({HOLD_RANGE[0]:g} to {HOLD_RANGE[1]:g} s)")
     ap.add_argument("--quick", action="store_true", help="10 s hold, 2 s lift hold, 5 %% bisection")
-    a = ap.parse_args(argv)
+    a = parse_args(ap, argv, _check_voltage)
     hold, lift_hold, rtol = (10.0, 2.0, 0.05) if a.quick else (a.hold, LIFT_HOLD, 0.02)
-    Path(a.out).parent.mkdir(parents=True, exist_ok=True)
 
     v_cf = closed_form_min_lift_voltage()
-    with ProcessPoolExecutor(max_workers=2) as pool:       # the long held run beside the bisection
+    # the long held run beside the bisection; stopped at once if the script is
+    pool = ProcessPoolExecutor(max_workers=2, initializer=worker_signals)
+    try:
         held = pool.submit(held_run, a.voltage, hold, a.out)
         lift = min_lift_voltage(0.8 * v_cf, 1.25 * v_cf, rtol, lift_hold)
         hard = hard_finger_check()
         held = held.result()
+    except BaseException:
+        stop_workers(pool)
+        raise
+    pool.shutdown()
     v_sim = lift["voltage_v"]
     # the torsional friction the soft-finger grasp needs at the threshold, mu R sin(theta):
     # theta when the base starts to rise in the lowest try that lifted (the bracket's top)
@@ -346,4 +383,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(run_script(main))

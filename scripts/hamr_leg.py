@@ -40,7 +40,7 @@ from __future__ import annotations
 
 import argparse
 import json
-from pathlib import Path
+import sys
 
 import mujoco
 import numpy as np
@@ -49,6 +49,8 @@ from scipy import optimize
 from controllers.hamr_leg import (LIFT, SWING, LegPhaseController, cycles_to_within, free_estimator, leg_scene,
                                   phase_errors_per_cycle, phase_loop_gains)
 from mjeap import Scene
+from mjeap.cli import arg_integer, arg_output, parse_args, run_script
+from mjeap.errors import check_integer
 from mjeap.frequency import phasor
 from mjeap.system import System, add_transmission, attach
 
@@ -275,13 +277,26 @@ def write_recording(path, system: System, run: dict) -> None:
     write_system_recording(path, run["result"], system, extra=extra, views=views)
 
 
+#: the most cycles of the closed-loop run: 100 s at 100 Hz, 11 million steps of the leg's
+#: 9.1 us timestep (the rollout's own bound is 20 million)
+MAX_CYCLES = 10_000
+
+
+def _check_cycles(a) -> None:
+    """At least one closed-loop cycle measured after the open-loop ones (a run of n cycles
+    measures the phase errors of its first n - 1)."""
+    check_integer("--open-loop-cycles", a.open_loop_cycles, 1, a.cycles - 2,
+                  f"at most --cycles {a.cycles} - 2, so that a closed-loop cycle is measured")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default="out/hamr_leg.rrd")
-    ap.add_argument("--cycles", type=int, default=40)
-    ap.add_argument("--open-loop-cycles", type=int, default=10)
-    a = ap.parse_args(argv)
-    Path(a.out).parent.mkdir(parents=True, exist_ok=True)
+    ap.add_argument("--out", default="out/hamr_leg.rrd", type=arg_output(), help="recording (.rrd)")
+    ap.add_argument("--cycles", type=arg_integer(3, MAX_CYCLES), default=40,
+                    help=f"cycles of the closed-loop run at 100 Hz, open-loop ones included (3 to {MAX_CYCLES})")
+    ap.add_argument("--open-loop-cycles", type=arg_integer(1), default=10,
+                    help="cycles before the phase loops close (1 to --cycles - 2)")
+    a = parse_args(ap, argv, _check_cycles)
     d = design()
     system = build(d)
     out = {"leg_length_m": LEG_LENGTH, "assumed": "leg length", "design": d}
@@ -305,4 +320,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(run_script(main))

@@ -31,12 +31,13 @@ from __future__ import annotations
 
 import argparse
 import json
-from pathlib import Path
+import sys
 
 import mujoco
 import numpy as np
 
 from controllers.self_sensing import calibrate_on_free_actuator
+from mjeap.cli import arg_output, parse_args, run_script
 from mjeap.system import System, add_transmission, attach
 
 T_EFF = 4000.0                                  # rad/m, seed 003 section 6.1
@@ -140,10 +141,9 @@ def write_recording(path, system, traces: dict) -> None:
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default="out/robobee_wing.rrd")
+    ap.add_argument("--out", default="out/robobee_wing.rrd", type=arg_output(), help="recording (.rrd)")
     ap.add_argument("--quick", action="store_true", help="60, 120, 180, 240 Hz only")
-    a = ap.parse_args(argv)
-    Path(a.out).parent.mkdir(parents=True, exist_ok=True)
+    a = parse_args(ap, argv)
     freqs = FREQUENCIES[1::2] if a.quick else FREQUENCIES
     out = {"t_eff_rad_per_m": T_EFF, "wing_span_m": SPAN, "wing_chord_m": CHORD, "wing_mass_kg": WING_MASS,
            "wing_source": "secondary: Harvard Microrobotics Lab public wing models (avikde/robobee3d)", "sweeps": {}}
@@ -167,4 +167,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(run_script(main))

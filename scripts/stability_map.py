@@ -10,21 +10,26 @@ arm (k a tan(kL) = 1) with the instantaneous EI and with the relaxed EI (eq. 8's
 stiffness, x 0.3/0.52), and the paper's own Region 3 model's marginal mass.
 """
 import argparse
+import sys
 from pathlib import Path
 
 import numpy as np
 
+from mjeap.cli import arg_integer, arg_output, parse_args, run_script
 from mjeap.stability import MAP_BASE, column_limits, simulated_edges
 from mjeap.sweep import EXECUTORS, grid, read_results, run_sweep
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default="out/stability")
-    ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--out", default="out/stability", type=arg_output(inside="results.csv"),
+                    help="folder of results.csv, stability_map.png, report.md and stability_map.rrd")
+    ap.add_argument("--workers", type=arg_integer(1), default=2)
     ap.add_argument("--executor", default="processes", choices=EXECUTORS)
-    ap.add_argument("--masses", type=int, default=11, help="payload masses from 0 to 150 mg")
-    ap.add_argument("--amplitudes", type=int, default=6, help="amplitudes from 0.25 to 1.5 V")
-    a = ap.parse_args(argv)
+    ap.add_argument("--masses", type=arg_integer(2, 1000), default=11,
+                    help="payload masses from 0 to 150 mg, 0 left out (2 to 1000)")
+    ap.add_argument("--amplitudes", type=arg_integer(1, 1000), default=6,
+                    help="amplitudes from 0.25 to 1.5 V (1 to 1000); the map runs masses x amplitudes points")
+    a = parse_args(ap, argv)
     out = Path(a.out)
     masses = np.linspace(0.0, 150e-6, a.masses)[1:]
     amps = np.linspace(0.25, 1.5, a.amplitudes)
@@ -93,4 +98,4 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(run_script(main))

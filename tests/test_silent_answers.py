@@ -198,7 +198,7 @@ def test_bare_waveform_text_is_one_waveform():
     assert np.array_equal(runs[0].tip_curvature, rollout_batch(s, ["step:1V"], 0.02, nthread=1)[0].tip_curvature)
     runs = rollout_batch(s, "step:1V", 0.02, initial_curvatures=[0.0, 20.0], nthread=1)
     assert len(runs) == 2 and runs[1].tip_curvature[0] != runs[0].tip_curvature[0]
-    with pytest.raises(ParameterError, match=r"initial_curvatures.*one per run \(3 voltages\)"):
+    with pytest.raises(ParameterError, match=r"initial_curvatures.*one per voltage \(3\)"):
         rollout_batch(s, ["step:1V"] * 3, 0.02, initial_curvatures=[0.0, 20.0])
 
 

@@ -111,26 +111,61 @@ class Drive:
     GENERIC_PARAMETERS: ClassVar[Dict[str, Tuple[float, str, str]]] = {}
     #: accepted (low, high) of numeric parameters, open bounds; every numeric one must be finite
     RANGES: ClassVar[Dict[str, Tuple[float, float]]] = {}
+    #: names of the layers the drive's physics reads (an actuator without them is refused,
+    #: naming the actuators the drive applies to)
+    LAYERS: ClassVar[Tuple[str, ...]] = ()
     model_used: str = ""
 
     def __init__(self, scene, **params):
         self.scene = scene
         # the actuator the drive acts on: a Scene's one part, or a part of a System
         self.part = getattr(scene, "part", scene)
+        self._check_actuator(scene.actuator)
         defaults = self.PARAMETERS.get(scene.actuator.id, self.GENERIC_PARAMETERS)
+        known = self._parameter_table()
+        if not defaults and known:      # no defaults for this actuator: every parameter must be given
+            missing = [k for k in known if k not in params]
+            if missing:
+                raise ParameterError("drive", self.name,
+                                     f"a drive for {', '.join(self.PARAMETERS)} (those it has defaults for), or every "
+                                     f"parameter given: {', '.join(known)}",
+                                     f"{scene.actuator.id} has no defaults; missing {', '.join(missing)}")
         self.params = {k: v[0] for k, v in defaults.items()}
         self.sources = {k: f"{v[1]}; {v[2]}" for k, v in defaults.items()}
         for k, v in params.items():
-            if defaults and k not in defaults and k not in self.extra_parameters():
-                raise ParameterError(f"{self.name} parameter", k, f"one of {', '.join(sorted(defaults))}")
+            if known and k not in known and k not in self.extra_parameters():
+                raise ParameterError(f"{self.name} parameter", k, f"one of {', '.join(sorted(known))}")
             self.params[k] = v
             self.sources[k] = "given by the user"
         self._check_parameters()
 
+    def _check_actuator(self, actuator) -> None:
+        """Refuse an actuator without the layers the drive reads (:attr:`LAYERS`)."""
+        names = [l.name for l in actuator.layers]
+        missing = [n for n in self.LAYERS if n not in names]
+        if not missing:
+            return
+        try:
+            own = f"; its own drive is '{default_drive_name(actuator.id)}'"
+        except UnknownNameError:
+            own = ""
+        layers = " and ".join(f"'{n}'" for n in self.LAYERS)
+        raise ParameterError("drive", self.name,
+                             f"a drive for an actuator with {layers} layer{'s' if len(self.LAYERS) > 1 else ''} "
+                             f"(in the catalog: {', '.join(self.actuators)})",
+                             f"{actuator.id} has layers {', '.join(names)}{own}")
+
+    def _parameter_table(self) -> Dict[str, Tuple[float, str, str]]:
+        """The parameters this drive takes, with their defaults for this actuator, or the
+        first described actuator's (their types) where it has none."""
+        return (self.PARAMETERS.get(self.scene.actuator.id) or self.GENERIC_PARAMETERS
+                or next(iter(self.PARAMETERS.values()), {}))
+
     def _check_parameters(self) -> None:
         """Every parameter that defaults to a number must be a finite number, within RANGES."""
+        table = self._parameter_table()
         for k, v in self.params.items():
-            default = self.PARAMETERS.get(self.scene.actuator.id, self.GENERIC_PARAMETERS).get(k, (None,))[0]
+            default = table.get(k, (None,))[0]
             if not isinstance(default, (int, float)) or isinstance(default, bool):
                 continue
             if isinstance(v, bool) or not isinstance(v, (int, float, np.number)) or not np.isfinite(v):

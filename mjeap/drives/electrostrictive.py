@@ -84,6 +84,7 @@ def active_layer(actuator) -> int:
 class ElectrostrictiveDrive(Drive):
     name = "electrostrictive"
     actuators = ("pvdf-60", "pvdf-60-half", "pvdf-130")
+    LAYERS = ("terpolymer",)
     PARAMETERS = {a: {"strain_coefficient": (STRAIN_COEFFICIENT, "m^2/V^2", _Q),
                       "relative_permittivity": (45.0, "-", f"{_T}, Table 5.2 (dielectric constant; model='maxwell')"),
                       "model": ("eigenstrain", "-", "electrostrictive eigenstrain S = Q E^2 (or 'maxwell', thesis "

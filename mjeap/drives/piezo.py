@@ -56,6 +56,7 @@ class PiezoBimorphDrive(Drive):
     name = "piezo-bimorph"
     actuators = ("pzt-hamr-large", "pzt-hamr-small", "pzt-robobee")
     model_used = "unipolar simultaneous drive, Wood/Jafferis effective stress"
+    LAYERS = ("pzt-top", "carbon-fibre")
     PARAMETERS = {"pzt-hamr-large": _params(45.5), "pzt-hamr-small": _params(32.2), "pzt-robobee": _params(10.1)}
     GENERIC_PARAMETERS = _params(32.2)
     RANGES = {"bias": (0.0, 200.0 + 1e-9), "f31": (0.0, np.inf), "capacitance": (0.0, np.inf),
