@@ -140,20 +140,37 @@ def _params(pairs) -> dict:
 
 def cmd_rollout(args) -> int:
     from .rollout import rollout
+    from .accuracy import check_accuracy
+    if args.accuracy is not None:
+        check_accuracy(args.accuracy)
+        for flag, given in (("--timestep", args.timestep), ("--estimate-error", args.estimate_error or None)):
+            if given is not None:
+                raise ParameterError(flag, given, f"no {flag} with --accuracy (the target chooses the model and "
+                                     "estimates its error)")
     scene = _scene_from_args(args)
     params = _params(args.param)
     r = rollout(scene, args.voltage, args.duration, drive=args.drive, drive_params=params,
                 initial_curvature=args.initial_curvature, rrd=args.rrd, csv_path=args.csv,
-                progress=None if not args.quiet else False, engine=args.engine, max_steps=args.max_steps)
+                progress=None if not args.quiet else False, engine=args.engine, max_steps=args.max_steps,
+                accuracy=args.accuracy, estimate_error=args.estimate_error)
     summary = {"actuator": scene.actuator.id, "drive": r.meta["drive"], "engine": r.meta["engine"],
                "engine_reason": r.meta.get("engine_reason", ""),
                "voltage": args.voltage,
-               "duration_s": args.duration, "timestep_s": scene.timestep, "steps": r.meta["steps"],
+               "duration_s": args.duration, "segments": r.meta["scene"]["segments"],
+               "integrator": r.meta["scene"]["integrator"], "timestep_s": r.meta["scene"]["timestep"],
+               "steps": r.meta["steps"],
                "wall_time_s": round(r.meta["wall_time_s"], 3),
                "tip_curvature_final_per_m": float(r.tip_curvature[-1]),
                "tip_curvature_peak_to_peak_per_m": r.peak_to_peak(),
                "tip_deflection_final_m": float(r.tip_position[-1, 1]),
                "rrd": args.rrd, "csv": args.csv}
+    if "accuracy" in r.meta:
+        a = r.meta["accuracy"]
+        summary["accuracy"] = {"quantity": a["quantity"], "target": a["target"],
+                               "estimated_error": a["estimated_error"], "estimate": a["estimate"]}
+        if a["target"] is not None:
+            summary["accuracy"].update(predicted_error=a["predicted_error"], runs=len(a["runs"]),
+                                       wall_time_all_runs_s=round(a["wall_time_s"], 3))
     if r.meta.get("warnings"):
         summary["warnings"] = r.meta["warnings"]
         for w in r.meta["warnings"]:
@@ -311,6 +328,11 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--engine", choices=ENGINES, default="auto",
                    help="'loop' (Python lockstep), 'threaded' (mujoco.rollout; open-loop drives only) or "
                         "'auto' (threaded where it applies; default)")
+    p.add_argument("--accuracy", type=float, default=None,
+                   help="largest error of the tip curvature relative to its swing (1e-5 to 0.2): segments, "
+                        "integrator and timestep are chosen for it and the error is estimated (mjeap.accuracy)")
+    p.add_argument("--estimate-error", action="store_true",
+                   help="without --accuracy: estimate this model's error with a coarser companion run")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_rollout)
     p = sub.add_parser("validate", help="run the validation experiments; report, figures and recordings")

@@ -346,7 +346,8 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
             initial_curvature: float = 0.0, rrd: Union[str, Path, None] = None,
             csv_path: Union[str, Path, None] = None, sample_interval: Optional[float] = None,
             progress: Optional[bool] = None, check_every: int = 100, controller=None,
-            engine: str = "auto", max_steps: Optional[int] = None) -> RolloutResult:
+            engine: str = "auto", max_steps: Optional[int] = None, accuracy: Optional[float] = None,
+            estimate_error: bool = False) -> RolloutResult:
     """Run ``scene`` driven by ``drive`` (name, instance or None for the actuator's own)
     with ``voltage`` (waveform text, :class:`Waveform` or callable v(t)) for ``duration`` s.
 
@@ -360,6 +361,12 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     'loop', 'threaded' (open-loop drives only, see the module) or 'auto'. Refused before
     any work: a duration shorter than a step, more than ``max_steps`` steps (default
     MAX_STEPS), a waveform above the step's Nyquist frequency.
+
+    ``accuracy`` (default: the scene's own, if any): the largest error of the tip curvature
+    relative to its swing; the run then chooses its segments, integrator and timestep
+    (:mod:`mjeap.accuracy`; ``scene`` is left as it was) and ``meta['accuracy']`` carries the
+    model and its estimated error. Without one the scene's model runs; ``estimate_error``
+    then estimates its error with a coarser companion run (about 0.35 x the cost).
     """
     from .drives import make_drive
     from . import recording, threaded
@@ -369,6 +376,10 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     wave = None if controller is not None else _waveform(voltage, duration)
     drv = drive if (drive is not None and not isinstance(drive, str)) else \
         make_drive(drive, scene, **(drive_params or {}))
+    target = accuracy if accuracy is not None else (None if scene.chosen_model else scene.accuracy)
+    if target is not None or estimate_error:
+        return _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, csv_path, sample_interval,
+                                    check_every, controller, engine, max_steps, target, wave)
     engine, engine_reason = _choose_engine(engine, scene, drv, controller)
     dt = scene.timestep
     v_steps = _voltage_steps(wave, duration, dt, drv, max_steps)
@@ -410,6 +421,38 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
         if csv_path is not None and samples.n > 0:
             writers.append((csv_path, lambda: result.to_csv(csv_path)))
         write_outputs(writers, error, result)
+    return result
+
+
+def _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, csv_path, sample_interval,
+                         check_every, controller, engine, max_steps, target, wave) -> RolloutResult:
+    """:func:`rollout` at an accuracy target (or, without one, with its error estimated): the
+    runs of :mod:`mjeap.accuracy`, each with the drive ``drv`` names and its parameters;
+    the outputs hold the chosen run, whose meta says how it was chosen."""
+    from . import accuracy as acc, recording
+    from .drives import make_drive
+    params = dict(drv.params)
+    if target is not None:
+        acc.check_accuracy(target)
+
+    def run(s, interval):
+        return rollout(s, voltage, duration, drive=make_drive(drv.name, s, **params),
+                       initial_curvature=initial_curvature, sample_interval=interval, progress=False,
+                       check_every=check_every, controller=controller, engine=engine, max_steps=max_steps)
+
+    if target is None:
+        chosen = scene
+        result = run(scene, sample_interval)
+        acc.estimate_error(scene, run, result, duration=duration, sample_interval=sample_interval)
+    else:
+        result, chosen, _ = acc.run_at_accuracy(scene, run, accuracy=target, duration=duration, wave=wave,
+                                                sample_interval=sample_interval)
+    writers = []
+    if rrd is not None:
+        writers.append((rrd, lambda: recording.write_recording(rrd, result, chosen)))
+    if csv_path is not None:
+        writers.append((csv_path, lambda: result.to_csv(csv_path)))
+    write_outputs(writers, None, result)
     return result
 
 
@@ -493,14 +536,16 @@ def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable
                   drive: Optional[str] = None, drive_params: Optional[dict] = None,
                   initial_curvatures: Union[float, Sequence[float]] = 0.0,
                   sample_interval: Optional[float] = None, nthread: Optional[int] = None,
-                  engine: str = "auto") -> List[RolloutResult]:
+                  engine: str = "auto", accuracy: Optional[float] = None) -> List[RolloutResult]:
     """Many rollouts of one scene, one per entry of ``voltages`` (and of
     ``initial_curvatures``, 1/m, a scalar for all; a single waveform runs once per initial
     curvature, or once), on MuJoCo's threaded rollout with ``nthread`` threads (1 to the
     number of CPUs; default: one per CPU): the drive compiled into the model (``native``)
     or its moment history as applied forces (``threaded``); ``auto`` takes the first that
     applies. Same results as :func:`rollout` run one by one with that
-    engine; raises ParameterError where neither applies."""
+    engine; raises ParameterError where neither applies. ``accuracy`` (default: the
+    scene's own): one model is chosen for the whole batch, for its worst member
+    (:mod:`mjeap.accuracy`), and each result carries its own estimated error."""
     from .drives import make_drive
     from . import threaded
 
@@ -524,6 +569,18 @@ def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable
                              f"an array of shape {np.shape(initial_curvatures)}",
                              f"one number (1/m) for all or one per voltage ({len(voltages)})")
     kappa0 = [check_initial_curvature(k, scene.layout.length, "initial_curvatures") for k in kappa0]
+    target = accuracy if accuracy is not None else (None if scene.chosen_model else scene.accuracy)
+    if target is not None:
+        from .accuracy import run_at_accuracy
+        waves = [_waveform(v, duration) for v in voltages]
+        fastest = max(waves, key=lambda w: getattr(w, "max_frequency", 0.0) or 0.0)
+        make_drive(drive, scene, **(drive_params or {}))          # the drive's parameters, checked first
+
+        def run(s, interval):
+            return rollout_batch(s, voltages, duration, drive=drive, drive_params=drive_params,
+                                 initial_curvatures=kappa0, sample_interval=interval, nthread=nthread, engine=engine)
+        return run_at_accuracy(scene, run, accuracy=target, duration=duration, wave=fastest,
+                               sample_interval=sample_interval)[0]
     drives = [make_drive(drive, scene, **(drive_params or {})) for _ in voltages]
     engine, _ = _choose_engine(engine, scene, drives[0], None)
     if engine == "loop":

@@ -144,7 +144,10 @@ class Scene:
     :class:`UnitSystem`), ``timestep`` (s, default from the model), ``integrator``
     ('implicitfast' | 'discrete'), ``damping_ratio`` (first-mode, default from the
     catalog), ``gravity`` (bool), ``max_bend`` (rad: tip angle up to which the cable's
-    timestep is checked for stability; the hinge chain needs none).
+    timestep is checked for stability; the hinge chain needs none), ``accuracy`` (a
+    target for this scene's rollouts, relative to the swing of the tip curvature: they
+    then choose segments, integrator and timestep themselves and report their error,
+    :mod:`mjeap.accuracy`; the scene as built keeps the arguments given).
     """
 
     def __init__(self, actuator: Union[str, Actuator], representation: str = "hinge",
@@ -152,8 +155,16 @@ class Scene:
                  payload: Union[Payload, str, None] = None, units: Optional[UnitSystem] = None,
                  timestep: Optional[float] = None, integrator: str = "implicitfast",
                  damping_ratio: Optional[float] = None, gravity: bool = True,
-                 max_bend: float = DEFAULT_MAX_BEND):
+                 max_bend: float = DEFAULT_MAX_BEND, accuracy: Optional[float] = None):
+        from .accuracy import check_accuracy
         self.actuator = get_actuator(actuator)
+        self.accuracy = None if accuracy is None else check_accuracy(accuracy)
+        #: set by :meth:`variant` for a model chosen by :mod:`mjeap.accuracy`: its timestep
+        #: is bound by stability only (the accuracy target replaces the fixed rules)
+        self.chosen_model = getattr(self, "chosen_model", False)
+        self._arguments = dict(actuator=self.actuator, representation=representation, orientation=orientation,
+                               payload=payload, units=units, damping_ratio=damping_ratio, gravity=gravity,
+                               max_bend=max_bend, accuracy=accuracy)
         get_builder(representation)
         clamp_rotation(orientation)
         if integrator not in INTEGRATORS:
@@ -253,16 +264,17 @@ class Scene:
             f"stability limit of {self.actuator.id} ({self.representation}, {self.layout.segments} "
             f"segments) under {self.integrator}: highest bending mode {wmax / u.time / 2 / np.pi:.4g} Hz "
             f"with explicit stiffness, Rayleigh damping beta = {beta * u.time:.3g} s"))]
-        if numerical:
+        if numerical and not self.chosen_model:     # a chosen model: the accuracy target binds instead
             self._timestep_limits.append((T_short / STEPS_PER_PERIOD, (
                 f"accuracy under discrete: {STEPS_PER_PERIOD} steps per period of the first mode of "
                 f"{self.actuator.id} (T = {T_short * u.time:.4g} s)")))
             if beta > 0:
-                h_acc = min(h_acc, 0.5 * beta)
                 self._timestep_limits.append((0.5 * beta, (
                     f"damping under discrete: the step damps the first mode by beta = h itself and the joints "
                     f"carry the rest (beta - h) K of {self.actuator.id}'s Rayleigh beta = {beta * u.time:.4g} s "
                     f"(damping ratio {zeta:g}); h <= beta / 2 keeps at least half in the joints")))
+        if numerical and beta > 0:
+            h_acc = min(h_acc, 0.5 * beta)
         if timestep is None:
             # rounded down to 3 significant figures in SI: a clean number that does not
             # depend on the internal units (the limit itself is known to ~1e-4)
@@ -275,7 +287,7 @@ class Scene:
                       + ")")
         else:
             h = self.check_timestep(timestep) / u.time
-            reason = "given by the user"
+            reason = "chosen for an accuracy target (mjeap.accuracy)" if self.chosen_model else "given by the user"
         self.spec.option.timestep = h
         h_num = h if numerical else 0.0
         choice = TimestepChoice(
@@ -308,6 +320,18 @@ class Scene:
         numerical = c.integrator == "discrete" and self.representation == "hinge"
         beta = c.rayleigh_beta - (timestep if numerical else 0.0)
         return max(beta, 0.0) / u.time * self.layout.hinge_stiffness / u.rotational_stiffness
+
+    def variant(self, segments: int, timestep: float, integrator: str) -> "Scene":
+        """This scene (actuator, orientation, payload, units, damping, gravity) as a model
+        of ``segments`` hinges stepped at ``timestep`` (s) under ``integrator``, as chosen for
+        an accuracy target (:mod:`mjeap.accuracy`): only its stability limit binds the
+        timestep; above beta under 'discrete' the step's own damping h K exceeds the beam's,
+        an error the target's estimate accounts for."""
+        s = Scene.__new__(Scene)
+        s.chosen_model = True
+        Scene.__init__(s, **{**self._arguments, "segments": segments, "timestep": timestep,
+                             "integrator": integrator})
+        return s
 
     def _uniform_arc_qpos(self, model: mujoco.MjModel, tip_angle: float) -> np.ndarray:
         q = model.qpos0.copy()

@@ -43,6 +43,7 @@ PARAMETERS: Dict[str, object] = {
     "actuator": "pedot-micro", "representation": "hinge", "segments": 20, "orientation": "horizontal",
     "payload_mass": 0.0, "payload_position": None, "waveform": "square", "amplitude": 1.0, "frequency": 0.1,
     "offset": 0.0, "duration": None, "initial_curvature": 0.0, "damping_ratio": None, "engine": "auto",
+    "accuracy": None,
 }
 
 
@@ -87,7 +88,19 @@ def metric_max_tip_deflection(r, point, scene) -> float:
     return float(np.abs(r.tip_position[:, 1]).max())
 
 
+def metric_estimated_error(r, point, scene) -> str:
+    """With an ``accuracy`` target: the estimated error of the tip curvature relative to its
+    swing and the model chosen for it, e.g. '0.0031 (12 segments, discrete, h = 0.00333 s)'
+    (:mod:`mjeap.accuracy`); '' without one."""
+    a = r.meta.get("accuracy")
+    if not a:
+        return ""
+    m = a["model"]
+    return f"{a['estimated_error']:.3g} ({m['segments']} segments, {m['integrator']}, h = {m['timestep']:.3g} s)"
+
+
 METRICS: Dict[str, Callable] = {
+    "estimated_error": metric_estimated_error,
     "peak_to_peak": metric_peak_to_peak, "returns": metric_returns, "settling_time": metric_settling_time,
     "max_stress_proxy": metric_max_stress_proxy, "max_tip_deflection": metric_max_tip_deflection,
 }
@@ -196,7 +209,8 @@ def evaluate(point: dict, metrics: Sequence[str] = ("peak_to_peak", "returns"), 
                 raise ParameterError("payload_position", None, "a position in m when payload_mass > 0")
             payload = Payload(float(p["payload_mass"]), float(pos))
         scene = Scene(p["actuator"], representation=p["representation"], segments=int(p["segments"]),
-                      orientation=p["orientation"], payload=payload, damping_ratio=p["damping_ratio"])
+                      orientation=p["orientation"], payload=payload, damping_ratio=p["damping_ratio"],
+                      accuracy=None if p["accuracy"] in (None, "") else float(p["accuracy"]))
         f = float(p["frequency"])
         duration = p["duration"] if p["duration"] is not None else 2.0 / f
         kind = p["waveform"]

@@ -1,0 +1,347 @@
+"""Runs at a stated accuracy: the cheapest hinge-chain model (segments, integrator, timestep)
+whose error stays below a target, and an a-posteriori estimate of the error it made.
+
+The quantity: the tip curvature kappa (1/m, the arc through clamp and tip, as seed 000
+measures it). A run's error is max over its samples of |kappa - kappa_converged| divided by
+the swing (peak to peak) of kappa over the run: ``accuracy=1e-3`` asks for 0.1 % of the swing.
+
+A priori, the error of N segments stepped at h is modelled as
+
+    e(N, h) = sqrt((a / N^2)^2 + (b h)^2)
+
+* a / N^2: the midpoint-rule chain converges in segments with order 2 (measured 2.00,
+  tests/test_convergence.py). ``a`` is measured on the run itself by two pilot runs of
+  PILOT_SEGMENTS (6 and 12) at one coarse step: their difference is a (1/6^2 - 1/12^2), the
+  step's error (about the same in both) cancelling (pilots of 4 and 8 segments gave
+  estimates above 3 x the true error on 2 of 24 seeded cases, 6 and 12 on 1 of 24). It holds
+  the geometry (a chord of a bent segment is shorter than its arc: (kappa L / N)^2 / 24) and
+  the discretised gravity and payload loads.
+* b h: the semi-implicit (and under 'discrete' backward) Euler step with the drive's moment
+  held over it (zero-order hold) is first order in h (measured on seed 000-002's beams; the
+  beam follows its drive about a step late). ``b`` is measured by a third pilot of 6
+  segments at h / 2: its difference from the first is b h / 2 (the segments' error
+  cancelling).
+
+The two are combined in quadrature, not added: the chord error is largest where the beam is
+most bent, the lag where it moves fastest, at different instants (on seed 000's heaviest run
+the sum overstates the default model's error 1.9 x, the root sum of squares 1.3 x).
+The cheapest (N, h) with e(N, h) <= target / SAFETY is taken, a step costing about
+COST_PER_STEP = c0 + c1 N (measured, ``scripts/bench.py``): under ``implicitfast`` where 4 h
+is within its default share of the stability limit (cheaper per step), else under
+``discrete`` (no stability limit on the hinge chain; above the Rayleigh beta the step's own
+damping h K exceeds the beam's, which shows in the estimate).
+
+A posteriori: the chosen run F = (N, h) and two companions of the same N at 2 h and 4 h. The
+step's observed order is 1 to 2 (1 for a beam following its drive, 2 for the phase of a
+lightly damped mode), so the rate is measured, not assumed: with d1 = max|F - F_2h| and
+d2 = max|F_2h - F_4h| over the swing, r = d2 / d1 and Richardson's extrapolation gives the
+step's error d1 / (r - 1) (r clipped to RATIO_RANGE). The segments' error is a / N^2 with the
+pilots' a (order 2 is established); the estimate combines both in quadrature.
+
+Where that exceeds the target, the model's constants are scaled by estimate / e(F) and a
+finer F is run with its own companions (at most MAX_REFINEMENTS times; a target not met then
+is said in the result's warnings). A run, its companions and the pilots share their
+integrator: 'implicitfast' where 4 h stays within the default step, else 'discrete'. All runs
+sample the same instants (every timestep divides the sample interval), so their curvatures
+are compared sample by sample.
+
+Measured on 24 seeded cases (``mjeap.validation.accuracy_claim``, seed 23: four actuators
+with their drives, targets 1e-4 .. 1e-2): the true error is below the target in all (at most
+0.57 x it), the estimate 0.93 to 3.9 x the true error, within 3 x in 23 of 24.
+"""
+from __future__ import annotations
+
+import math
+import time as _time
+from dataclasses import dataclass, asdict
+from typing import List, Optional
+
+import numpy as np
+
+from .errors import ParameterError
+
+__all__ = ["QUANTITY", "ACCURACY_RANGE", "Model", "ErrorModel", "check_accuracy", "relative_difference",
+           "calibrate", "choose_model", "run_at_accuracy", "estimate_error"]
+
+QUANTITY = ("tip curvature: max over the samples of |kappa - kappa_converged| / swing, the swing being the "
+            "peak-to-peak tip curvature of the run")
+#: targets accepted (relative to the swing): below 1e-5 the converged reference itself is
+#: in doubt (round-off of the arc read-out); above 0.2 the answer is not a simulation
+ACCURACY_RANGE = (1e-5, 0.2)
+PILOT_SEGMENTS = (6, 12)
+MIN_SEGMENTS, MAX_SEGMENTS = 4, 200
+#: the companions of a run (N, h): the same N at 2 h and at 4 h
+COMPANION_STEPS = (2, 4)
+#: the model is chosen for target / SAFETY (the a-priori model is good to about 2x, the
+#: refinement catches the rest)
+SAFETY = 1.5
+MAX_REFINEMENTS = 2
+#: cost of a native step, c0 + c1 N (us, this 2-core machine, seed 000's beam; only the
+#: ratio matters) and the extra of 'discrete' over 'implicitfast' per step
+COST_PER_STEP = (3.0, 0.6)
+DISCRETE_COST = 1.15
+#: samples of an accuracy run when no sample_interval is given (the grid all runs share)
+GRID_SAMPLES = 2000
+#: at most this fraction of the first mode's period, and of the waveform's, per step
+STEPS_PER_PERIOD_MIN = 8
+
+
+def check_accuracy(value) -> float:
+    """``value`` as a target relative to the swing, refused outside ACCURACY_RANGE."""
+    lo, hi = ACCURACY_RANGE
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        v = float("nan")
+    if isinstance(value, bool) or not (lo <= v <= hi):
+        raise ParameterError("accuracy", value, f"a number in [{lo:g}, {hi:g}]: the largest error of the tip "
+                             "curvature relative to its swing (1e-3 = 0.1 %)")
+    return v
+
+
+@dataclass(frozen=True)
+class Model:
+    """A discretisation: ``segments`` hinges stepped at ``timestep`` (s) under ``integrator``."""
+    segments: int
+    timestep: float
+    integrator: str
+
+    def describe(self) -> str:
+        return f"{self.segments} segments, {self.integrator}, h = {self.timestep:.4g} s"
+
+
+@dataclass(frozen=True)
+class ErrorModel:
+    """e(N, h) = sqrt((spatial / N^2)^2 + (temporal h)^2), relative to the swing (temporal
+    in 1/s)."""
+    spatial: float
+    temporal: float
+
+    def predict(self, model: Model) -> float:
+        return math.hypot(self.spatial / model.segments ** 2, self.temporal * model.timestep)
+
+    def scaled(self, factor: float) -> "ErrorModel":
+        return ErrorModel(self.spatial * factor, self.temporal * factor)
+
+
+def relative_difference(a, b) -> float:
+    """max |kappa_a - kappa_b| over the instants both sampled, over a's swing."""
+    ia = {round(t, 9): i for i, t in enumerate(np.round(a.time, 9))}
+    pairs = [(ia[round(t, 9)], j) for j, t in enumerate(np.round(b.time, 9)) if round(t, 9) in ia]
+    if not pairs:
+        raise ValueError("the two runs share no sample instant")
+    i, j = np.array(pairs).T
+    swing = float(np.ptp(a.tip_curvature))
+    d = float(np.max(np.abs(a.tip_curvature[i] - b.tip_curvature[j])))
+    return d / swing if swing > 0 else (0.0 if d == 0 else math.inf)
+
+
+def _grid(duration: float, sample_interval: Optional[float]) -> float:
+    return sample_interval if sample_interval else duration / GRID_SAMPLES
+
+
+def _on_grid(h: float, grid: float) -> float:
+    """The largest grid / m (m a whole number) not above h."""
+    return grid / max(1, math.ceil(grid / h * (1 - 1e-12)))
+
+
+def _step_cap(scene, wave, grid: float) -> float:
+    """The largest step any model may take: the sample interval, 1/STEPS_PER_PERIOD_MIN of the
+    first mode's period and of the waveform's shortest period."""
+    cap = min(grid, 1.0 / (STEPS_PER_PERIOD_MIN * scene.choice.first_frequency))
+    f = getattr(wave, "max_frequency", 0.0) or 0.0
+    if f > 0:
+        cap = min(cap, 1.0 / (STEPS_PER_PERIOD_MIN * f))
+    return cap
+
+
+def _integrator_for(scene, h: float) -> str:
+    """'implicitfast' where h and the companions' 4 h are within its default share of the
+    stability limit (about the Rayleigh beta: the default step), else 'discrete': a run and
+    its companions always share their integrator (its error's form)."""
+    return "implicitfast" if COMPANION_STEPS[-1] * h <= scene.choice.rayleigh_beta else "discrete"
+
+
+def _cost(model: Model, duration: float) -> float:
+    c0, c1 = COST_PER_STEP
+    return duration / model.timestep * (c0 + c1 * model.segments) * \
+        (DISCRETE_COST if model.integrator == "discrete" else 1.0)
+
+
+def choose_model(scene, error_model: ErrorModel, target: float, duration: float, grid: float,
+                 h_cap: float) -> Model:
+    """The cheapest model with predicted error <= target / SAFETY (h on the sample grid)."""
+    tau = target / SAFETY
+    best = None
+    for n in range(MIN_SEGMENTS, MAX_SEGMENTS + 1):
+        e_n = error_model.spatial / n ** 2
+        if e_n >= tau:
+            continue
+        room = math.sqrt(tau ** 2 - e_n ** 2)
+        h = h_cap if error_model.temporal <= 0 else min(h_cap, room / error_model.temporal)
+        h = _on_grid(h, grid / COMPANION_STEPS[-1])          # the companions' steps divide the grid too
+        m = Model(n, h, _integrator_for(scene, h))
+        if best is None or _cost(m, duration) < _cost(best, duration):
+            best = m
+    if best is None:         # even MAX_SEGMENTS are predicted too coarse: the finest there is
+        h = _on_grid(min(h_cap, 0.5 * tau / max(error_model.temporal, 1e-300)), grid / COMPANION_STEPS[-1])
+        best = Model(MAX_SEGMENTS, h, _integrator_for(scene, h))
+    return best
+
+
+def _check_work(model: Model, duration: float, target: float, em: ErrorModel) -> None:
+    from .rollout import MAX_STEPS
+    n = duration / model.timestep
+    if n > MAX_STEPS:
+        raise ParameterError("accuracy", target, "a target this run can reach within "
+                             f"{MAX_STEPS:,} steps", f"{model.describe()} would take {n:,.0f} steps; the step's error "
+                             f"constant b = {em.temporal:.3g} 1/s of this question (pilots)")
+
+
+class _Runner:
+    """Runs ``model``s of one scene and question, keeping every run's record."""
+
+    def __init__(self, scene, run, duration: float, grid: float):
+        self.scene, self.run_fn, self.duration, self.grid = scene, run, duration, grid
+        self.runs: List[dict] = []
+
+    def __call__(self, model: Model, role: str):
+        try:
+            s = self.scene.variant(model.segments, model.timestep, model.integrator)
+        except ParameterError:
+            if model.integrator != "implicitfast":
+                raise
+            model = Model(model.segments, model.timestep, "discrete")     # beyond its stability limit
+            s = self.scene.variant(model.segments, model.timestep, model.integrator)
+        t0 = _time.perf_counter()
+        out = self.run_fn(s, self.grid)
+        self.runs.append({"role": role, **asdict(model), "wall_time_s": _time.perf_counter() - t0})
+        return s, model, out
+
+
+def _worst(values) -> float:
+    return max(values) if isinstance(values, (list, tuple)) else values
+
+
+def _each(results) -> list:
+    return results if isinstance(results, list) else [results]
+
+
+def calibrate(runner: _Runner, h_pilot: float) -> ErrorModel:
+    """The constants from three pilots: a from PILOT_SEGMENTS at one step h (the step's error
+    cancels), b from the coarser at h and h / 2 (the segments' error cancels)."""
+    n1, n2 = PILOT_SEGMENTS
+    integ = _integrator_for(runner.scene, h_pilot / 2)
+    _, _, coarse = runner(Model(n1, h_pilot, integ), "pilot")
+    _, _, fine = runner(Model(n2, h_pilot, integ), "pilot")
+    _, _, half = runner(Model(n1, _on_grid(h_pilot / 2, runner.grid), integ), "pilot")
+    a = _worst([relative_difference(f, c) for f, c in zip(_each(fine), _each(coarse))]) / (n1 ** -2 - n2 ** -2)
+    h_half = runner.runs[-1]["timestep"]
+    b = _worst([relative_difference(f, c) for f, c in zip(_each(half), _each(coarse))]) / (h_pilot - h_half)
+    return ErrorModel(a, b)
+
+
+def _companions(model: Model) -> List[Model]:
+    """The same segments and integrator at 2 h and 4 h."""
+    return [Model(model.segments, k * model.timestep, model.integrator) for k in COMPANION_STEPS]
+
+
+#: the observed ratio of successive step differences is clipped to 2^0.9 .. 2^2.1: the
+#: step's order lies between 1 and 2 (semi-implicit and backward Euler: 1; their phase error
+#: on a lightly damped mode: 2); outside, the differences are not yet asymptotic or cancel
+RATIO_RANGE = (2 ** 0.9, 2 ** 2.1)
+
+
+def _estimate(fine, mid, coarse, spatial: float) -> List[float]:
+    """The step's error by Richardson with the observed rate (d1 = |F - T2h|, d2 = |T2h -
+    T4h|, max over shared samples relative to F's swing; r = d2 / d1, e_h = d1 / (r - 1)),
+    combined in quadrature with the segments' error ``spatial`` (a / N^2 from the pilots)."""
+    out = []
+    for f, m, c in zip(_each(fine), _each(mid), _each(coarse)):
+        d1 = relative_difference(f, m)
+        d2 = relative_difference(m, c) * float(np.ptp(m.tip_curvature)) / max(float(np.ptp(f.tip_curvature)), 1e-300)
+        r = min(max(d2 / d1, RATIO_RANGE[0]), RATIO_RANGE[1]) if d1 > 0 else RATIO_RANGE[1]
+        out.append(math.hypot(d1 / (r - 1), spatial))
+    return out
+
+
+def _run_with_companions(runner, model: Model, role: str, spatial: float):
+    chosen, model, result = runner(model, role)
+    mid, coarse = [runner(c, "companion")[2] for c in _companions(model)]
+    return chosen, model, result, _estimate(result, mid, coarse, spatial / model.segments ** 2)
+
+
+def run_at_accuracy(scene, run, *, accuracy: float, duration: float, wave=None,
+                    sample_interval: Optional[float] = None):
+    """Choose, run and check a model of ``scene`` for ``accuracy``. ``run(scene, interval)``
+    runs one model sampled every ``interval`` s and returns a RolloutResult (or a list of
+    them, a batch: the model then serves its worst member). Returns (result(s), scene of
+    the chosen model, report dict), the report also put in each result's
+    ``meta['accuracy']``."""
+    target = check_accuracy(accuracy)
+    if scene.representation != "hinge":
+        raise ParameterError("accuracy", accuracy, "no target on a 'cable' scene (give segments and timestep): the "
+                             "accuracy model is the hinge chain's (order 2 in segments)")
+    t0 = _time.perf_counter()
+    grid = _grid(duration, sample_interval)
+    h_cap = _step_cap(scene, wave, grid)
+    runner = _Runner(scene, run, duration, grid)
+    h_pilot = _on_grid(min(h_cap, 2 * scene.choice.rayleigh_beta), grid)
+    em = calibrate(runner, h_pilot)
+    model = choose_model(scene, em, target, duration, grid, h_cap)
+    _check_work(model, duration, target, em)
+    chosen, model, result, estimates = _run_with_companions(runner, model, "chosen", em.spatial)
+    refinements = 0
+    while max(estimates) > target and refinements < MAX_REFINEMENTS:
+        refinements += 1
+        em = em.scaled(max(estimates) / em.predict(model))
+        prev_model = model
+        model = choose_model(scene, em, target, duration, grid, h_cap)
+        if em.predict(model) >= 0.7 * em.predict(prev_model):          # no finer model predicted
+            break
+        _check_work(model, duration, target, em)
+        chosen, model, result, estimates = _run_with_companions(runner, model, "refined", em.spatial)
+    met = max(estimates) <= target
+    report = {"quantity": QUANTITY, "target": target, "model": asdict(model),
+              "predicted_error": em.predict(model), "estimated_error": _worst(estimates) if len(estimates) > 1
+              else estimates[0], "met": met,
+              "estimate": "step: Richardson with the observed rate against companions of "
+                          + " and ".join(c.describe() for c in _companions(model))
+                          + f"; segments: a / N^2 = {em.spatial / model.segments ** 2:.3g} (pilots); in quadrature",
+              "error_model": {"spatial_a": em.spatial, "temporal_b_per_s": em.temporal,
+                              "form": "e = sqrt((a / N^2)^2 + (b h)^2)", "pilots": f"{PILOT_SEGMENTS[0]} and {PILOT_SEGMENTS[1]} "
+                                                                   f"segments at {h_pilot:.4g} s, {PILOT_SEGMENTS[0]} at "
+                                                                   "half that"},
+              "refinements": refinements, "runs": runner.runs, "wall_time_s": _time.perf_counter() - t0}
+    for r, e in zip(_each(result), estimates):
+        r.meta["accuracy"] = {**report, "estimated_error": e}
+        if not met:
+            r.meta.setdefault("warnings", []).append(
+                f"accuracy target {target:g} not met: estimated error {e:.3g} of the swing with {model.describe()} "
+                f"after {refinements} refinements")
+    return result, chosen, report
+
+
+def estimate_error(scene, run, result, *, duration: float, sample_interval: Optional[float]) -> dict:
+    """The error of ``result``, a run of ``scene`` as built (no target), estimated as
+    :func:`run_at_accuracy` does: the step's by companions at 2 h and 4 h (under 'discrete'
+    where 4 h would leave implicitfast's default share of its stability limit), the
+    segments' by a companion of N / sqrt 2 segments at h (order 2), sampled at every 4th of
+    its instants."""
+    model = Model(scene.layout.segments, scene.timestep, scene.integrator)
+    comps = _companions(model)
+    if model.integrator == "implicitfast" and comps[-1].timestep > scene.choice.rayleigh_beta:
+        comps = [Model(c.segments, c.timestep, "discrete") for c in comps]
+    n_s = max(2, int(round(model.segments / math.sqrt(2))))
+    interval = COMPANION_STEPS[-1] * (sample_interval or (result.time[1] - result.time[0] if len(result.time) > 1
+                                                          else duration))
+    mid, coarse, fewer = [run(scene.variant(c.segments, c.timestep, c.integrator), interval)
+                          for c in comps + [Model(n_s, model.timestep, model.integrator)]]
+    spatial = relative_difference(result, fewer) / ((model.segments / n_s) ** 2 - 1)
+    e = _estimate(result, mid, coarse, spatial)[0]
+    report = {"quantity": QUANTITY, "target": None, "model": asdict(model), "estimated_error": e,
+              "estimate": "step: Richardson with the observed rate against companions of "
+                          + " and ".join(c.describe() for c in comps)
+                          + f"; segments: against {n_s} segments (order 2): {spatial:.3g}; in quadrature"}
+    result.meta["accuracy"] = report
+    return report

@@ -1,0 +1,104 @@
+"""Runs at a stated accuracy (mjeap.accuracy): refusals, what a result carries, and the
+claim itself against converged runs on cases drawn by a seeded generator."""
+import json
+import math
+
+import numpy as np
+import pytest
+
+from mjeap import Scene
+from mjeap.accuracy import ACCURACY_RANGE, ErrorModel, Model, check_accuracy
+from mjeap.errors import ParameterError
+from mjeap.rollout import rollout, rollout_batch
+from mjeap.validation.accuracy_claim import check_case, draw_cases, summarise
+
+FAST = dict(orientation="horizontal")          # pedot-micro horizontal, first mode 207 Hz
+
+
+@pytest.mark.parametrize("bad", [0, 1.0, -1e-3, float("nan"), "tight", True, None, 1e-6])
+def test_accuracy_outside_its_range_is_refused_naming_it(bad):
+    if bad is None:
+        assert Scene("pedot-micro").accuracy is None
+        return
+    with pytest.raises(ParameterError, match=r"accuracy=.*\[1e-05, 0\.2\]"):
+        check_accuracy(bad)
+    with pytest.raises(ParameterError, match="accuracy"):
+        Scene("pedot-micro", accuracy=bad)
+
+
+def test_cable_scene_with_a_target_is_refused_before_any_run():
+    s = Scene("pedot-micro", representation="cable", segments=6)
+    with pytest.raises(ParameterError, match="cable"):
+        rollout(s, "step:1V", 0.01, accuracy=1e-2)
+
+
+def test_error_model_combines_in_quadrature():
+    em = ErrorModel(spatial=0.16, temporal=100.0)
+    assert em.predict(Model(4, 3e-4, "discrete")) == pytest.approx(math.hypot(0.01, 0.03))
+
+
+def test_a_target_chooses_the_model_and_the_result_says_so(tmp_path):
+    s = Scene("pedot-micro", accuracy=1e-2, **FAST)
+    r = rollout(s, "square:1V@2Hz", 0.5, rrd=tmp_path / "a.rrd", csv_path=tmp_path / "a.csv")
+    a = r.meta["accuracy"]
+    assert a["target"] == 1e-2 and a["quantity"].startswith("tip curvature")
+    assert a["estimated_error"] <= 1e-2 and a["met"]
+    assert [x["role"] for x in a["runs"]][:3] == ["pilot"] * 3
+    assert r.meta["scene"]["segments"] == a["model"]["segments"]
+    assert r.meta["scene"]["timestep"] == pytest.approx(a["model"]["timestep"])
+    assert s.layout.segments == 20 and s.time == 0.0            # the user's scene is left as it was
+    from mjeap.recording import _meta_markdown
+    assert "estimated_error" in _meta_markdown(r.meta)
+    assert (tmp_path / "a.rrd").stat().st_size > 0 and (tmp_path / "a.csv").stat().st_size > 0
+
+
+def test_a_chosen_discrete_step_may_exceed_the_fixed_rules_a_user_step_may_not():
+    s = Scene("pedot-micro", orientation="up", payload="12.6mg@6.27mm")
+    big = 8 * s.choice.rayleigh_beta
+    with pytest.raises(ParameterError, match="timestep"):
+        Scene("pedot-micro", orientation="up", payload="12.6mg@6.27mm", integrator="discrete", timestep=big)
+    v = s.variant(8, big, "discrete")
+    assert v.timestep == pytest.approx(big) and "accuracy target" in v.choice.reason
+    assert np.all(v.model.jnt_stiffness >= 0) and np.all(v.model.dof_damping >= 0)
+
+
+def test_no_target_keeps_the_model_and_can_estimate_its_error():
+    s = Scene("pedot-micro", **FAST)
+    plain = rollout(s, "sine:1V@5Hz", 0.2)
+    assert "accuracy" not in plain.meta
+    r = rollout(s, "sine:1V@5Hz", 0.2, estimate_error=True)
+    a = r.meta["accuracy"]
+    assert a["target"] is None and a["model"]["segments"] == 20 and a["model"]["timestep"] == s.timestep
+    assert 0 < a["estimated_error"] < 1e-2
+    np.testing.assert_array_equal(r.tip_curvature, plain.tip_curvature)
+
+
+def test_batch_at_a_target_shares_one_model_and_estimates_each():
+    s = Scene("pedot-micro", **FAST)
+    rs = rollout_batch(s, ["sine:0.5V@5Hz", "sine:1.5V@5Hz"], 0.2, nthread=1, accuracy=3e-3)
+    models = {json.dumps(r.meta["accuracy"]["model"], sort_keys=True) for r in rs}
+    assert len(models) == 1
+    assert all(r.meta["accuracy"]["estimated_error"] <= 3e-3 for r in rs)
+
+
+def test_cli_refuses_a_timestep_beside_a_target(capsys):
+    from mjeap.cli import main
+    rc = main(["rollout", "pedot-micro", "--voltage", "step:1V", "--duration", "0.01", "--accuracy", "1e-2",
+               "--timestep", "1e-5"])
+    assert rc != 0
+    assert "--timestep" in capsys.readouterr().err
+
+
+def test_the_accuracy_claim_on_seeded_cases():
+    """True error (against 2 x the segments at 1/4 of the step) below the target in at
+    least 95 % of cases (here: all), never above 2 x; the estimate within 3 x of it in at
+    least 90 % (10 of these 11; 23 of 24 with the next 13, scripts/bench.py: the one
+    outlier, a piezo sine at 1.8e-4, is estimated 3.9 x high)."""
+    rows = [check_case(c) for c in draw_cases(seed=23, n=11)]
+    s = summarise(rows)
+    detail = "\n".join(f"{r['case']}: true {r['true_error']:.3g}, estimate {r['estimated_error']:.3g}" for r in rows)
+    assert s["below_target"] >= 0.95, detail
+    assert s["worst_true_over_target"] <= 2.0, detail
+    assert s["estimate_within_3x"] >= 0.9, detail
+    assert s["estimate_over_true_range"][0] >= 1 / 3, detail         # never an estimate 3 x too low
+    assert ACCURACY_RANGE[0] <= min(r["target"] for r in rows)
