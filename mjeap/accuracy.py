@@ -69,6 +69,8 @@ QUANTITY = ("tip curvature: max over the samples of |kappa - kappa_converged| / 
 #: in doubt (round-off of the arc read-out); above 0.2 the answer is not a simulation
 ACCURACY_RANGE = (1e-5, 0.2)
 PILOT_SEGMENTS = (6, 12)
+#: the pilots step at PILOT_STEP x the Rayleigh beta (about the default step), within the cap
+PILOT_STEP = 2.0
 MIN_SEGMENTS, MAX_SEGMENTS = 4, 200
 #: the companions of a run (N, h): the same N at 2 h and at 4 h
 COMPANION_STEPS = (2, 4)
@@ -286,7 +288,7 @@ def run_at_accuracy(scene, run, *, accuracy: float, duration: float, wave=None,
     grid = _grid(duration, sample_interval)
     h_cap = _step_cap(scene, wave, grid)
     runner = _Runner(scene, run, duration, grid)
-    h_pilot = _on_grid(min(h_cap, 2 * scene.choice.rayleigh_beta), grid)
+    h_pilot = _on_grid(min(h_cap, PILOT_STEP * scene.choice.rayleigh_beta), grid)
     em = calibrate(runner, h_pilot)
     model = choose_model(scene, em, target, duration, grid, h_cap)
     _check_work(model, duration, target, em)

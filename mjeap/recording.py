@@ -142,15 +142,38 @@ def blueprint(result=None, scale: float = 1.0, grid_spacing: float = 1e-3, extra
 
 def _meta_markdown(meta: dict) -> str:
     lines = ["| parameter | value |", "|---|---|"]
+    a = meta.get("accuracy")
+    if a:       # first, where the panel opens: how far this run can be trusted
+        m = a["model"]
+        target = "no target" if a.get("target") is None else f"target {a['target']:g}"
+        lines.append(f"| estimated error (tip curvature / swing) | {a['estimated_error']:.2g} ({target}; "
+                     f"{m['segments']} segments, {m['integrator']}, h = {m['timestep']:.4g} s) |")
     for k, v in meta.items():
         if isinstance(v, dict):
             continue
         lines.append(f"| {k} | {v} |")
+    def cell(x):
+        if isinstance(x, dict):
+            return ", ".join(f"{a}: {_short(b)}" for a, b in x.items())
+        return _short(x)
+
     for k, v in meta.items():
         if isinstance(v, dict):
             lines += ["", f"**{k}**", "", "| name | value |", "|---|---|"]
-            lines += [f"| {kk} | {vv} |" for kk, vv in v.items()]
+            tables = {kk: vv for kk, vv in v.items() if isinstance(vv, list) and vv and isinstance(vv[0], dict)}
+            lines += [f"| {kk} | {cell(vv)} |" for kk, vv in v.items() if kk not in tables]
+            for kk, rows in tables.items():          # e.g. the runs an accuracy target made
+                cols = list(rows[0])
+                lines += ["", f"*{k}: {kk}*", "", "| " + " | ".join(cols) + " |", "|" + "---|" * len(cols)]
+                lines += ["| " + " | ".join(cell(r.get(c, "")) for c in cols) + " |" for r in rows]
     return "\n".join(lines)
+
+
+def _short(x) -> str:
+    """A number to 4 significant figures, anything else as it prints."""
+    if isinstance(x, float):
+        return f"{x:.4g}"
+    return str(x)
 
 
 def _log_outcome(rec, meta: dict, t, extra) -> None:

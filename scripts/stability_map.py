@@ -3,6 +3,7 @@ amplitude, each point a 0.1 Hz square-wave rollout judged by seed 000's criterio
 curvature still changes sign in the third period), run as an mjeap sweep.
 
     python scripts/stability_map.py [--out out/stability] [--workers 2] [--executor processes|dask]
+                                    [--accuracy 1e-2]
 
 Writes results.csv (resumable), stability_map.png, report.md and stability_map.rrd. The
 theory drawn over it is amplitude independent: the Euler column with the payload on a rigid
@@ -29,12 +30,20 @@ def main(argv=None):
                     help="payload masses from 0 to 150 mg, 0 left out (2 to 1000)")
     ap.add_argument("--amplitudes", type=arg_integer(1, 1000), default=6,
                     help="amplitudes from 0.25 to 1.5 V (1 to 1000); the map runs masses x amplitudes points")
+    ap.add_argument("--accuracy", type=float, default=None,
+                    help="tip-curvature error relative to its swing (1e-5 to 0.2) each point is run at: segments, "
+                         "integrator and timestep chosen per point, the estimate in the estimated_error column")
     a = parse_args(ap, argv)
+    if a.accuracy is not None:
+        from mjeap.accuracy import check_accuracy
+        check_accuracy(a.accuracy)
     out = Path(a.out)
     masses = np.linspace(0.0, 150e-6, a.masses)[1:]
     amps = np.linspace(0.25, 1.5, a.amplitudes)
     points = grid(payload_mass=[float(m) for m in masses], amplitude=[float(v) for v in amps])
-    s = run_sweep(points, out / "results.csv", metrics=("returns", "peak_to_peak", "max_stress_proxy"), base=MAP_BASE,
+    metrics = ("returns", "peak_to_peak", "max_stress_proxy") + (("estimated_error",) if a.accuracy else ())
+    base = {**MAP_BASE, **({"accuracy": a.accuracy} if a.accuracy else {})}
+    s = run_sweep(points, out / "results.csv", metrics=metrics, base=base,
                   executor=a.executor, workers=a.workers)
     print(f"{s.done} rollouts in {s.wall_s:.1f} s ({s.throughput:.2f}/s), {s.skipped} already done, {s.failed} failed")
     rows = read_results(out / "results.csv")
