@@ -71,6 +71,14 @@ def test_no_target_keeps_the_model_and_can_estimate_its_error():
     assert a["target"] is None and a["model"]["segments"] == 20 and a["model"]["timestep"] == s.timestep
     assert 0 < a["estimated_error"] < 1e-2
     np.testing.assert_array_equal(r.tip_curvature, plain.tip_curvature)
+    # against a converged run (40 segments at 1/8 of the step): within 3 x
+    ref_scene = s.variant(40, s.timestep / 8, "discrete")
+    from mjeap.accuracy import relative_difference
+    from mjeap.drives import make_drive
+    ref = rollout(ref_scene, "sine:1V@5Hz", 0.2, drive=make_drive(None, ref_scene),
+                  sample_interval=float(r.time[1] - r.time[0]))
+    true = relative_difference(ref, r)
+    assert 1 / 3 <= a["estimated_error"] / true <= 3, (a["estimated_error"], true)
 
 
 def test_batch_at_a_target_shares_one_model_and_estimates_each():
