@@ -29,10 +29,11 @@ from dm_env import specs
 from . import install_mujoco_warnings
 from .discretize import Payload
 from .drives import make_drive
-from .errors import ParameterError, check_positive, check_range
-from .outputs import guarded
+from .errors import MjeapError, ParameterError, check_positive, check_range
+from .outputs import guarded, provenance
 from .rollout import check_initial_curvature, one_voltage
 from .scene import Scene
+from .versions import dm_control_problem
 
 install_mujoco_warnings()         # dm_control's import installed its own MuJoCo warning handler
 
@@ -56,6 +57,7 @@ class BeamPhysics(engine.Physics):
 
     @classmethod
     def from_scene(cls, scene: Scene, drive) -> "BeamPhysics":
+        check_dm_control()
         physics = cls.from_model(wrapper.MjModel(scene.model))
         scene.data = physics.data.ptr       # the scene's read-outs now see the physics' state
         physics.scene, physics.drive, physics.voltage = scene, drive, 0.0
@@ -178,6 +180,13 @@ class CurvatureTrackingTask(base.Task):
         return float(rewards.tolerance(k - ref, bounds=(0.0, 0.0), margin=self.reward_margin, sigmoid="gaussian"))
 
 
+def check_dm_control() -> None:
+    """Refuse, naming the versions, where dm_control's Physics cannot run on this MuJoCo."""
+    why = dm_control_problem()
+    if why:
+        raise MjeapError(f"no dm_env environment here: {why}")
+
+
 def make_environment(actuator: str = "pedot-micro", reference: Optional[Callable[[float], float]] = None,
                      orientation: str = "up", payload: Optional[Payload] = Payload(12.6e-6, 6.27e-3),
                      payload_mass_range: Optional[Tuple[float, float]] = None,
@@ -187,6 +196,7 @@ def make_environment(actuator: str = "pedot-micro", reference: Optional[Callable
     """A ``dm_control.rl.control.Environment`` tracking ``reference(t)`` (1/m; default: a
     0.05 Hz sine of 50 1/m, seed 000's closed-loop case) with ``actuator``. The agent acts
     every ``control_interval`` s (rounded to whole MuJoCo steps) for ``time_limit`` s."""
+    check_dm_control()
     if reference is None:
         def reference(t):
             return 50.0 * np.sin(2 * np.pi * 0.05 * t)
@@ -236,7 +246,7 @@ def run_episode(env: control.Environment, policy: Callable, rrd=None):
     finally:
         t, v, p, a, k, cl, pay, sig = zip(*rows) if rows else ([],) * 8
         keys = list(sig[0]) if rows else []
-        meta = {"actuator": sc.actuator.id, "drive": physics.drive.describe(), "voltage": "agent",
+        meta = {**provenance(), "actuator": sc.actuator.id, "drive": physics.drive.describe(), "voltage": "agent",
                 "episode": dict(task.episode), "saturated_steps": task.saturated_steps,
                 "control_interval_s": env.control_timestep(), "scene": sc.summary()}
         if task.saturated_steps:

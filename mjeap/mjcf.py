@@ -25,7 +25,7 @@ import mujoco
 import numpy as np
 
 from .discretize import BeamLayout, Payload, block_inertia, clamp_rotation
-from .errors import UnknownNameError
+from .errors import ParameterError, UnknownNameError
 from .units import UnitSystem
 
 GRAVITY = 9.80665  # m/s^2
@@ -172,9 +172,16 @@ REPRESENTATIONS = tuple(BUILDERS)
 
 def get_builder(representation: str) -> BeamBuilder:
     try:
-        return BUILDERS[representation]
+        builder = BUILDERS[representation]
     except KeyError:
         raise UnknownNameError("representation", str(representation), BUILDERS) from None
+    from .versions import MUJOCO_VERSION, cable_available
+    if representation == "cable" and not cable_available():
+        raise ParameterError("representation", representation, "'hinge' on MuJoCo 4.x",
+                             f"MuJoCo {MUJOCO_VERSION} removed the cable plugin and <composite> (1D flexcomp rods "
+                             "replace them; mjeap's rod representation is not built yet); the cable runs on MuJoCo "
+                             "3.17")
+    return builder
 
 
 def arena_bytes(nv: int) -> int:

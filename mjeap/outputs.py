@@ -196,3 +196,11 @@ def guarded(*names: str):
                 return fn(*args, **kwargs)
         return run
     return wrap
+
+
+def provenance() -> dict:
+    """What every result's metadata (and so its recording and CSV's sidecar) says about the
+    software that made it: the MuJoCo and mjeap versions."""
+    import mujoco
+    from . import __version__
+    return {"mujoco": mujoco.__version__, "mjeap": __version__}

@@ -313,7 +313,8 @@ def _sample_steps(n_steps: int, dt: float, sample_interval: Optional[float]) -> 
 
 
 def _meta(scene, drv, wave, duration, initial_curvature, n_steps, engine) -> dict:
-    return {"actuator": scene.actuator.id, "drive": drv.describe(),
+    from .outputs import provenance
+    return {**provenance(), "actuator": scene.actuator.id, "drive": drv.describe(),
             "voltage": "closed loop" if wave is None else getattr(wave, "text", str(wave)),
             "duration_s": duration, "initial_curvature_per_m": initial_curvature, "steps": n_steps,
             "engine": engine, "scene": scene.summary(),

@@ -31,7 +31,8 @@ import numpy as np
 from . import native
 from .component import ActuatorPart
 from .errors import DivergenceError, ParameterError, UnknownNameError, check_positive
-from .outputs import guarded
+from .outputs import guarded, provenance
+from .versions import newton_sparse_broken
 from .rollout import one_voltage
 from .scene import DEFAULT_SEGMENTS, INTEGRATORS, Scene, apply_dof_damping, diverged
 from .units import DEFAULT_UNITS, UnitSystem
@@ -401,6 +402,8 @@ class System:
         spec.option.timestep = h / units.time
         spec.option.integrator = INTEGRATORS[integrator]
         spec.option.disableflags |= int(mujoco.mjtDisableBit.mjDSBL_AUTORESET)
+        if newton_sparse_broken():          # MuJoCo 4.0.0's sparse Cholesky bug (mjeap.versions)
+            spec.option.jacobian = mujoco.mjtJacobian.mjJAC_DENSE
         if contact is not None and any(a.contact for a in self.actuators):
             t_min = min(a.twin.layout.thickness for a in self.actuators if a.contact) / units.length
             contact.apply(spec, h / units.time, t_min, units.length)
@@ -638,7 +641,7 @@ class System:
                 a.drive.part = p
         active = [(i, v) for i, v in zip(self.actuator_ids, v_steps) if v is not None]
         ctrl_name = None if controller is None else getattr(controller, "name", type(controller).__name__)
-        meta = {"actuators": {a.prefix.rstrip("/"): {"actuator": a.twin.actuator.id,
+        meta = {**provenance(), "actuators": {a.prefix.rstrip("/"): {"actuator": a.twin.actuator.id,
                                                      "drive": None if a.drive is None else a.drive.describe(),
                                                      "voltage": (f"controller: {ctrl_name}" if controller is not None
                                                                  and a.drive is not None else

@@ -26,6 +26,7 @@ def test_accuracy_outside_its_range_is_refused_naming_it(bad):
         Scene("pedot-micro", accuracy=bad)
 
 
+@pytest.mark.cable
 def test_cable_scene_with_a_target_is_refused_before_any_run():
     s = Scene("pedot-micro", representation="cable", segments=6)
     with pytest.raises(ParameterError, match="cable"):

@@ -8,6 +8,8 @@ from mjeap import ParameterError, Payload, Scene, rollout
 from mjeap.environment import make_environment, run_episode
 from mjeap.recording import read_recording
 
+pytestmark = pytest.mark.dm_control  # dm_control's Physics: MuJoCo 3.x (mjeap.versions)
+
 
 def short_env(**kw):
     kw.setdefault("time_limit", 0.2)

@@ -57,6 +57,7 @@ def test_native_matches_the_golden_trajectories(actuator_id):
     assert np.max(np.abs(k - k_ref)) <= 1e-3 * np.ptp(k_ref)
 
 
+@pytest.mark.cable
 def test_auto_picks_native_and_says_why_not_otherwise():
     r = rollout(Scene("pedot-micro"), "step:1V", 0.05)
     assert r.meta["engine"] == "native"
@@ -86,6 +87,7 @@ def test_native_batch_on_two_threads_equals_one_by_one():
         np.testing.assert_array_equal(one.tip_curvature, r.tip_curvature)
 
 
+@pytest.mark.cable
 def test_generated_models_carry_units_and_the_drive():
     m = mujoco.MjModel.from_xml_path(str(ASSET_DIR / "pedot-micro_hinge.xml"))
     u = read_units(m)

@@ -112,6 +112,7 @@ def test_passive_beam_in_a_host_without_actuation_and_gravity_changed_after_atta
 
 
 # 4 ------------------------------------------------------------------------------------------
+@pytest.mark.dm_control
 @pytest.mark.parametrize("bounds", [(-1e5, 1e5), (float("nan"), 1.0), (0.0, float("inf"))])
 def test_environment_initial_curvatures_within_rollouts_bounds(bounds):
     """(-1e5, 1e5) 1/m started episodes 60 turns round; NaN overflowed. rollout's bounds
@@ -152,6 +153,7 @@ def test_read_units_reads_its_own_field_only():
 
 
 # 6 ------------------------------------------------------------------------------------------
+@pytest.mark.dm_control
 def test_policy_with_two_values_for_one_actuator_is_refused():
     from mjeap.environment import make_environment
     env = make_environment(time_limit=0.05, payload=None, orientation="horizontal")
@@ -203,6 +205,7 @@ def test_bare_waveform_text_is_one_waveform():
 
 
 # 7 ------------------------------------------------------------------------------------------
+@pytest.mark.cable
 @pytest.mark.parametrize("contact", [False, True])
 def test_cable_keeps_its_per_dof_damping_in_a_system(contact):
     """The cable's per-dof damping (stiff in-plane and twist directions) travels as

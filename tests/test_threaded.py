@@ -46,6 +46,7 @@ def test_threaded_equals_loop(actuator, representation, voltage, duration, param
     np.testing.assert_allclose(s.data.qfrc_applied, qfrc_loop, rtol=1e-12, atol=0)
 
 
+@pytest.mark.cable
 def test_auto_picks_threaded_only_where_it_applies():
     """auto: the drive compiled into the model where it has a native form (mjeap.native),
     else threaded where it is open-loop, else the loop."""
