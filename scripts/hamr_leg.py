@@ -87,7 +87,6 @@ def build(d: dict, bias: float = BIAS) -> System:
     spec = mujoco.MjSpec.from_string('<mujoco><option gravity="0 0 -9.80665e-3"/><worldbody/></mujoco>')
     wb = spec.worldbody
     acts = {}
-    L = None
     for k, (name, z) in enumerate((("swing", 0.0), ("lift", -4.0))):
         site = wb.add_site(name=f"{name}_mount", pos=[-14.0, -3.0 - 3.0 * k, z])
         acts[name] = attach(spec, ACTUATOR, site=site.name, prefix=name, contact=False, drive_params={"bias": bias})

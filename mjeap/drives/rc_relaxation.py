@@ -155,7 +155,6 @@ class RCRelaxationDrive(Drive):
     def native_signals(self, k, part, handles, prefix=""):
         """From the native state: v_c is the activation, the relaxation moment k1 r_j of
         each arm (k r of the loop drive's internal variable), both after step k."""
-        u = self.scene.units
         z, pm, _ = self._internal_rates()
         qadr, aadr = self._relaxation_adr(part, handles, prefix)
         self._s[-1] = part.data.act[aadr]
