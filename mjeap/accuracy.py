@@ -60,7 +60,7 @@ import numpy as np
 
 from .errors import ParameterError
 
-__all__ = ["QUANTITY", "ACCURACY_RANGE", "Model", "ErrorModel", "check_accuracy", "relative_difference",
+__all__ = ["QUANTITY", "ACCURACY_RANGE", "Model", "ErrorModel", "check_accuracy", "target_for", "relative_difference",
            "calibrate", "choose_model", "run_at_accuracy", "estimate_error"]
 
 QUANTITY = ("tip curvature: max over the samples of |kappa - kappa_converged| / swing, the swing being the "
@@ -86,6 +86,14 @@ DISCRETE_COST = 1.15
 GRID_SAMPLES = 2000
 #: at most this fraction of the first mode's period, and of the waveform's, per step
 STEPS_PER_PERIOD_MIN = 8
+
+
+def target_for(scene, accuracy: Optional[float]) -> Optional[float]:
+    """The target a run of ``scene`` works to: ``accuracy`` if given, else the scene's own
+    (none for a model already chosen for one, :meth:`Scene.variant`)."""
+    if accuracy is not None:
+        return accuracy
+    return None if scene.chosen_model else scene.accuracy
 
 
 def check_accuracy(value) -> float:
@@ -208,8 +216,8 @@ def _check_work(model: Model, duration: float, target: float, em: ErrorModel) ->
 class _Runner:
     """Runs ``model``s of one scene and question, keeping every run's record."""
 
-    def __init__(self, scene, run, duration: float, grid: float):
-        self.scene, self.run_fn, self.duration, self.grid = scene, run, duration, grid
+    def __init__(self, scene, run, grid: float):
+        self.scene, self.run_fn, self.grid = scene, run, grid
         self.runs: List[dict] = []
 
     def __call__(self, model: Model, role: str):
@@ -226,10 +234,6 @@ class _Runner:
         return s, model, out
 
 
-def _worst(values) -> float:
-    return max(values) if isinstance(values, (list, tuple)) else values
-
-
 def _each(results) -> list:
     return results if isinstance(results, list) else [results]
 
@@ -242,9 +246,9 @@ def calibrate(runner: _Runner, h_pilot: float) -> ErrorModel:
     _, _, coarse = runner(Model(n1, h_pilot, integ), "pilot")
     _, _, fine = runner(Model(n2, h_pilot, integ), "pilot")
     _, _, half = runner(Model(n1, _on_grid(h_pilot / 2, runner.grid), integ), "pilot")
-    a = _worst([relative_difference(f, c) for f, c in zip(_each(fine), _each(coarse))]) / (n1 ** -2 - n2 ** -2)
+    a = max([relative_difference(f, c) for f, c in zip(_each(fine), _each(coarse))]) / (n1 ** -2 - n2 ** -2)
     h_half = runner.runs[-1]["timestep"]
-    b = _worst([relative_difference(f, c) for f, c in zip(_each(half), _each(coarse))]) / (h_pilot - h_half)
+    b = max([relative_difference(f, c) for f, c in zip(_each(half), _each(coarse))]) / (h_pilot - h_half)
     return ErrorModel(a, b)
 
 
@@ -292,7 +296,7 @@ def run_at_accuracy(scene, run, *, accuracy: float, duration: float, wave=None,
     t0 = _time.perf_counter()
     grid = _grid(duration, sample_interval)
     h_cap = _step_cap(scene, wave, grid)
-    runner = _Runner(scene, run, duration, grid)
+    runner = _Runner(scene, run, grid)
     h_pilot = _on_grid(min(h_cap, PILOT_STEP * scene.choice.rayleigh_beta), grid)
     em = calibrate(runner, h_pilot)
     model = choose_model(scene, em, target, duration, grid, h_cap)
@@ -310,8 +314,7 @@ def run_at_accuracy(scene, run, *, accuracy: float, duration: float, wave=None,
         chosen, model, result, estimates = _run_with_companions(runner, model, "refined", em.spatial)
     met = max(estimates) <= target
     report = {"quantity": QUANTITY, "target": target, "model": asdict(model),
-              "predicted_error": em.predict(model), "estimated_error": _worst(estimates) if len(estimates) > 1
-              else estimates[0], "met": met,
+              "predicted_error": em.predict(model), "estimated_error": max(estimates), "met": met,
               "estimate": "step: Richardson with the observed rate against companions of "
                           + " and ".join(c.describe() for c in _companions(model))
                           + f"; segments: a / N^2 = {em.spatial / model.segments ** 2:.3g} (pilots); in quadrature",

@@ -32,6 +32,7 @@ from . import csvio
 from .analytical import arc_curvature
 from .errors import DivergenceError, ParameterError, check_integer, check_positive, check_range
 from .outputs import deferred_signals, guarded, replacing
+from .accuracy import target_for
 from .scene import Scene
 from .waveforms import Waveform, parse_waveform
 
@@ -377,7 +378,7 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     wave = None if controller is not None else _waveform(voltage, duration)
     drv = drive if (drive is not None and not isinstance(drive, str)) else \
         make_drive(drive, scene, **(drive_params or {}))
-    target = accuracy if accuracy is not None else (None if scene.chosen_model else scene.accuracy)
+    target = target_for(scene, accuracy)
     if target is not None or estimate_error:
         return _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, csv_path, sample_interval,
                                     check_every, controller, engine, max_steps, target, wave)
@@ -433,8 +434,6 @@ def _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, 
     from . import accuracy as acc, recording
     from .drives import make_drive
     params = dict(drv.params)
-    if target is not None:
-        acc.check_accuracy(target)
 
     def run(s, interval):
         return rollout(s, voltage, duration, drive=make_drive(drv.name, s, **params),
@@ -570,7 +569,7 @@ def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable
                              f"an array of shape {np.shape(initial_curvatures)}",
                              f"one number (1/m) for all or one per voltage ({len(voltages)})")
     kappa0 = [check_initial_curvature(k, scene.layout.length, "initial_curvatures") for k in kappa0]
-    target = accuracy if accuracy is not None else (None if scene.chosen_model else scene.accuracy)
+    target = target_for(scene, accuracy)
     if target is not None:
         from .accuracy import run_at_accuracy
         waves = [_waveform(v, duration) for v in voltages]

@@ -46,6 +46,7 @@ import numpy as np
 import scipy.linalg
 
 from . import analytical
+from .accuracy import check_accuracy
 from .catalog import Actuator, get_actuator
 from .component import ActuatorPart, write_hinge_angles
 from .discretize import BeamLayout, Payload, check_payload, clamp_rotation, discretize
@@ -156,7 +157,6 @@ class Scene:
                  timestep: Optional[float] = None, integrator: str = "implicitfast",
                  damping_ratio: Optional[float] = None, gravity: bool = True,
                  max_bend: float = DEFAULT_MAX_BEND, accuracy: Optional[float] = None):
-        from .accuracy import check_accuracy
         self.actuator = get_actuator(actuator)
         self.accuracy = None if accuracy is None else check_accuracy(accuracy)
         #: set by :meth:`variant` for a model chosen by :mod:`mjeap.accuracy`: its timestep
