@@ -374,9 +374,14 @@ def _run_processes(jobs: list, workers: int):
         inflight = {}
         try:
             while pending or inflight:
+                broken = False
                 while pending and len(inflight) < workers:
-                    args = pending.pop(0)
-                    inflight[ex.submit(evaluate, *args)] = args
+                    try:                    # the pool may break between a finished point and this submit
+                        fut = ex.submit(evaluate, *pending[0])
+                    except BrokenProcessPool:
+                        broken = True
+                        break
+                    inflight[fut] = pending.pop(0)
                 done, _ = wait(inflight, return_when=FIRST_COMPLETED)
                 for fut in done:
                     args = inflight.pop(fut)
@@ -384,7 +389,7 @@ def _run_processes(jobs: list, workers: int):
                         yield fut.result()
                     except BrokenProcessPool:
                         suspects.append(args)
-                if suspects:
+                if suspects or broken:
                     suspects += list(inflight.values())
                     break
         except BaseException:               # Ctrl-C, SIGTERM, the caller closing: stop the workers now
