@@ -300,6 +300,11 @@ def cmd_sweep(args) -> int:
     return 0
 
 
+def cmd_robot(args) -> int:
+    from .robots import get
+    return get(args.name).main(args.options) or 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="mjeap", description=__doc__)
     sub = ap.add_subparsers(dest="command", required=True)
@@ -335,6 +340,12 @@ def build_parser() -> argparse.ArgumentParser:
                    help="without --accuracy: estimate this model's error with a coarser companion run")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_rollout)
+    p = sub.add_parser("robot", help="run a robot's experiment (mjeap.robots): gripper, hamr-leg, robobee-wing",
+                       description="Run a registered robot's experiment; its options follow the name "
+                                   "(mjeap robot NAME --help).")
+    p.add_argument("name", help="a registered robot (mjeap.robots.names())")
+    p.add_argument("options", nargs=argparse.REMAINDER, help="the robot experiment's own options")
+    p.set_defaults(func=cmd_robot)
     p = sub.add_parser("validate", help="run the validation experiments; report, figures and recordings")
     p.add_argument("experiments", nargs="*", help="experiment names or prefixes (default: all)")
     p.add_argument("--out", default="out/validation", help="report folder (default: out/validation)")

@@ -14,6 +14,7 @@ mass range below the actuator's stability limit (``mjeap validate`` reports it).
 """
 from __future__ import annotations
 
+import argparse
 import collections
 import warnings
 from typing import Callable, Optional, Tuple
@@ -27,6 +28,7 @@ from dm_control.utils import rewards
 from dm_env import specs
 
 from . import install_mujoco_warnings
+from .cli import arg_integer, arg_number, arg_output, parse_args
 from .discretize import Payload
 from .drives import make_drive
 from .errors import MjeapError, ParameterError, check_positive, check_range
@@ -260,3 +262,38 @@ def run_episode(env: control.Environment, policy: Callable, rrd=None):
         if rrd is not None and rows:
             write_outputs([(rrd, lambda: write_recording(rrd, result, sc))], error, result)
     return result
+
+
+# ---------------------------------------------------------------- the example episode
+def reference(t):
+    """The episode's reference curvature (1/m) at ``t`` (s): 50 1/m at 0.05 Hz."""
+    return 50.0 * np.sin(2 * np.pi * 0.05 * np.asarray(t))
+
+
+def main(argv=None):
+    """One recorded episode under the curvature tracker: ``python scripts/env_episode.py --help``."""
+    ap = argparse.ArgumentParser(description="One episode of the dm_env curvature-tracking environment, recorded.")
+    ap.add_argument("--seed", type=arg_integer(0), default=0)
+    ap.add_argument("--duration", type=arg_number(0.01, 600.0, "s"), default=20.0,
+                    help="simulated time of the episode (s): from one agent step (10 ms) to 600 s")
+    ap.add_argument("--out", default="out/env-episode.rrd", type=arg_output(), help="recording (.rrd)")
+    a = parse_args(ap, argv)
+    from .controllers.curvature_tracking import CurvatureTracker
+    env = make_environment("pedot-micro", reference, payload_mass_range=(1e-6, 12.6e-6),
+                           initial_curvature_range=(-20.0, 20.0), time_limit=a.duration, seed=a.seed)
+    tracker = CurvatureTracker(reference, a.duration + 1.0, interval=env.control_timestep())
+    physics = env.physics
+
+    def policy(time_step):
+        if time_step.first():
+            tracker.reset(physics.scene, physics.drive)
+        return np.array([tracker(physics.time(), physics.scene)])
+
+    r = run_episode(env, policy, rrd=a.out)
+    err = r.tip_curvature - r.signals["reference_curvature (1/m)"]
+    second_half = r.time >= a.duration / 2
+    print(f"episode: {env.task.episode}")
+    print(f"{len(r.time) - 1} agent steps of {env.control_timestep() * 1e3:.3g} ms; mean reward "
+          f"{np.nanmean(r.signals['reward (-)']):.3f}; RMS error over the second half "
+          f"{np.sqrt(np.mean(err[second_half] ** 2)):.3g} 1/m; clipped actions {env.task.saturated_steps}")
+    print(f"wrote {a.out}")

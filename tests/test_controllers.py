@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from controllers.curvature_tracking import CurvatureTracker
+from mjeap.controllers.curvature_tracking import CurvatureTracker
 from mjeap import DivergenceError, Payload, Scene, rollout
 
 AMP, F_REF, T = 50.0, 0.05, 40.0

@@ -1,18 +1,11 @@
-"""The PEDOT micro-gripper of scripts/gripper.py, shortened: grip force against the
+"""The PEDOT micro-gripper of mjeap.robots.gripper, shortened: grip force against the
 back-relaxation's closed form (the 60 s hold is the script's), the lift threshold against
 2 mu F = m g (a 2 s hold; the script holds 10 s and bisects), and the hard-finger grasp's
 rolling (why the fingers' contacts are soft-finger)."""
-import importlib.util
-import sys
-from pathlib import Path
-
 import numpy as np
 import pytest
 
-_spec = importlib.util.spec_from_file_location("gripper", Path(__file__).parent.parent / "scripts" / "gripper.py")
-gripper = importlib.util.module_from_spec(_spec)
-sys.modules["gripper"] = gripper
-_spec.loader.exec_module(gripper)
+from mjeap.robots import gripper
 
 
 def test_grip_force_follows_the_relaxing_closed_form():

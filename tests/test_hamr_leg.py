@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from controllers.hamr_leg import SWING, leg_scene, pid_gains, run_leg
+from mjeap.controllers.hamr_leg import SWING, leg_scene, pid_gains, run_leg
 from mjeap.recording import read_recording
 from mjeap.validation.mechanics import free_vibration_frequency
 

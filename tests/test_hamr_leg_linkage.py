@@ -1,24 +1,15 @@
-"""The HAMR leg of scripts/hamr_leg.py (seed 003, section 6.2), shortened (the full sweeps
+"""The HAMR leg of mjeap.robots.hamr_leg (seed 003, section 6.2), shortened (the full sweeps
 and the 40-cycle run are the script's): two actuators, a rigid leg on swing and lift
 joints, transmissions as tendon equalities, the foot's position from the 3D kinematics.
 
 References: the point-mass leg (controllers/hamr_leg.py: the actuator's own modes with the
 reflected leg mass at its tip) for the resonances, T x Wood's free deflection for the
 static gain, and the paper's 5 degrees within 25 cycles for the phase loops."""
-import importlib.util
-import sys
-from pathlib import Path
-
 import numpy as np
 import pytest
 
-
 import harvard
-
-_spec = importlib.util.spec_from_file_location("hamr_leg_script", Path(__file__).parent.parent / "scripts" / "hamr_leg.py")
-leg = importlib.util.module_from_spec(_spec)
-sys.modules["hamr_leg_script"] = leg
-_spec.loader.exec_module(leg)
+from mjeap.robots import hamr_leg as leg
 
 #: seed 003: within 5 degrees in under 25 cycles (250 ms) at 100 Hz
 PHASE_TOL_DEG, MAX_CYCLES = 5.0, 25

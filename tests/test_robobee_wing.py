@@ -1,22 +1,13 @@
-"""The RoboBee wing of scripts/robobee_wing.py, shortened (the 30-270 Hz sweeps are the
+"""The RoboBee wing of mjeap.robots.robobee_wing, shortened (the 30-270 Hz sweeps are the
 script's): the transmission against closed forms, the stroke's rise to the transmission
 resonance and fall after, and the self-sensing estimate within the paper's 10 %."""
-import importlib.util
-import sys
-from pathlib import Path
-
 import numpy as np
 import pytest
 
+import harvard
 from mjeap import Scene
 from mjeap.discretize import Payload
-
-import harvard
-
-_spec = importlib.util.spec_from_file_location("robobee_wing", Path(__file__).parent.parent / "scripts" / "robobee_wing.py")
-robobee = importlib.util.module_from_spec(_spec)
-sys.modules["robobee_wing"] = robobee
-_spec.loader.exec_module(robobee)
+from mjeap.robots import robobee_wing as robobee
 
 
 def test_quasi_static_stroke_is_t_eff_times_the_free_deflection():

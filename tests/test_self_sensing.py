@@ -3,7 +3,7 @@ catalog (its residual tip mass fitted to the measured 1750 Hz resonance)."""
 import numpy as np
 import pytest
 
-from controllers.self_sensing import SelfSensingEstimator, calibrate, quasi_static_alpha
+from mjeap.controllers.self_sensing import SelfSensingEstimator, calibrate, quasi_static_alpha
 from mjeap import Scene, rollout
 from mjeap.drives import make_drive
 from mjeap.errors import ParameterError
