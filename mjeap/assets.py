@@ -40,6 +40,7 @@ def asset_xml(actuator_id: str, representation: str) -> str:
         spec = s.spec.copy()
         native.add_units(spec, s.units)
         drive_note = f"Passive beam: {why}. Drive it with mjeap (loop or threaded engine)."
+    add_viewing(spec, s)
     drive_note = "\n".join(textwrap.wrap(drive_note, 95, initial_indent=" " * 5, subsequent_indent=" " * 5)) + "\n"
     c = s.choice
     header = (
@@ -56,6 +57,28 @@ def asset_xml(actuator_id: str, representation: str) -> str:
            if representation != "hinge" else "")
         + "-->\n")
     return header + spec.to_xml()
+
+
+def add_viewing(spec, scene: Scene) -> None:
+    """What a viewer needs to see the bend (nothing that acts on the physics): the free
+    camera looks down the hinge axis (the beam bends in its clamp's x-y plane, which the
+    default view looks along), a key light, and a grid floor behind the beam that touches
+    nothing (contype = conaffinity = 0)."""
+    import mujoco
+    length = (scene.layout.length + scene.layout.extension_length) / scene.units.length
+    width = float(max(scene.layout.link_width)) / scene.units.length
+    g = spec.visual.global_
+    g.azimuth, g.elevation = 90.0, -70.0
+    spec.add_texture(name="grid", type=mujoco.mjtTexture.mjTEXTURE_2D, builtin=mujoco.mjtBuiltin.mjBUILTIN_CHECKER,
+                     rgb1=[0.82, 0.84, 0.86], rgb2=[0.72, 0.74, 0.76], width=256, height=256,
+                     mark=mujoco.mjtMark.mjMARK_EDGE, markrgb=[0.5, 0.5, 0.55])
+    grid = spec.add_material(name="grid", texrepeat=[4, 4], texuniform=True, reflectance=0.0)
+    grid.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = "grid"
+    spec.worldbody.add_geom(name="floor", type=mujoco.mjtGeom.mjGEOM_PLANE, material="grid",
+                            size=[1.2 * length, 1.2 * length, length / 10], pos=[length / 2, 0, -width],
+                            contype=0, conaffinity=0, group=2)
+    spec.worldbody.add_light(name="key", pos=[length / 2, -length, 2 * length], dir=[0, 0.45, -0.9],
+                             diffuse=[0.35, 0.35, 0.35])
 
 
 def iter_assets() -> Iterator[Tuple[str, str]]:

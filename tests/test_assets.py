@@ -1,5 +1,6 @@
 """assets/mjcf is up to date, and every model compiles and stays at rest when unforced."""
 import mujoco
+import numpy as np
 import pytest
 
 from mjeap import DEFAULT_UNITS, get_actuator, load_mjcf
@@ -75,3 +76,17 @@ def test_arena_is_sized_to_the_beam(representation, segments):
         assert s.data.narena < 2 * 2**20
     s.run(20 * s.timestep)
     assert s.data.maxuse_arena < s.data.narena
+
+
+@pytest.mark.parametrize("actuator_id", ["pedot-micro", "pzt-hamr-small"])
+def test_the_viewer_looks_at_the_bending_plane_with_a_light_and_a_floor_that_touches_nothing(actuator_id):
+    """The beam bends in its clamp's x-y plane (the hinge axis is z): the viewer's free
+    camera must look along z (within 25 deg), not along the deflection y; a light and a
+    floor that collides with nothing."""
+    m = mujoco.MjModel.from_xml_path(str(ASSET_DIR / asset_name(actuator_id, "hinge")))
+    az, el = np.radians(m.vis.global_.azimuth), np.radians(m.vis.global_.elevation)
+    forward = np.array([np.cos(el) * np.cos(az), np.cos(el) * np.sin(az), np.sin(el)])
+    assert abs(forward[2]) > np.cos(np.radians(25))
+    assert m.nlight >= 1
+    floor = m.geom("floor")
+    assert floor.type[0] == mujoco.mjtGeom.mjGEOM_PLANE and floor.contype[0] == 0 and floor.conaffinity[0] == 0
