@@ -205,7 +205,7 @@ def choose_model(scene, error_model: ErrorModel, target: float, duration: float,
 
 
 def _check_work(model: Model, duration: float, target: float, em: ErrorModel) -> None:
-    from .rollout import MAX_STEPS
+    from .engines.frame import MAX_STEPS
     n = duration / model.timestep
     if n > MAX_STEPS:
         raise ParameterError("accuracy", target, "a target this run can reach within "

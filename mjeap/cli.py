@@ -327,7 +327,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--initial-curvature", type=float, default=0.0, help="start as a uniform arc (1/m)")
     p.add_argument("--rrd", help="write a Rerun recording here")
     p.add_argument("--csv", help="write the time series here")
-    from .rollout import ENGINES
+    from .engines import ENGINES
     p.add_argument("--max-steps", type=int, default=None,
                    help="refuse runs of more steps than this (default 20,000,000: minutes of work)")
     p.add_argument("--engine", choices=ENGINES, default="auto",
@@ -457,7 +457,7 @@ def arg_output(inside: Optional[str] = None):
     """argparse ``type=``: an output path that can be written (its folder made now), or,
     with ``inside``, a folder in which the file ``inside`` can be written
     (:func:`mjeap.rollout.check_outputs`). Returns the text."""
-    from .rollout import check_outputs
+    from .outputs import check_outputs
 
     def check(text: str) -> str:
         check_outputs(out=Path(text) / inside if inside else text)

@@ -33,7 +33,8 @@ from .discretize import Payload
 from .drives import make_drive
 from .errors import MjeapError, ParameterError, check_positive, check_range
 from .outputs import guarded, provenance
-from .rollout import check_initial_curvature, one_voltage
+from .engines.frame import check_initial_curvature, one_voltage
+from .engines.loop import advance
 from .scene import Scene
 from .versions import dm_control_problem
 
@@ -74,11 +75,8 @@ class BeamPhysics(engine.Physics):
         return self.scene.time
 
     def step(self, nstep: int = 1) -> None:
-        m, d, dt = self.model.ptr, self.data.ptr, self.scene.timestep
-        with self.check_invalid_state():
-            for _ in range(nstep):
-                self.drive.step(self.voltage, dt)
-                mujoco.mj_step(m, d)
+        with self.check_invalid_state():       # the loop engine's lockstep: drive, then MuJoCo
+            advance(self.model.ptr, self.data.ptr, self.drive, self.voltage, self.scene.timestep, nstep)
         self.scene._step_count += nstep
         self.scene.check_finite()
         self.scene.update_kinematics()
@@ -221,7 +219,8 @@ def run_episode(env: control.Environment, policy: Callable, rrd=None):
     Ctrl-C or SIGTERM; a second writer of it is refused, :func:`mjeap.outputs.guarded`)."""
     from .analytical import arc_curvature
     from .recording import write_recording
-    from .rollout import RolloutResult, write_outputs
+    from .engines.frame import RolloutResult
+    from .outputs import write_outputs
 
     physics, task = env.physics, env.task
     sc = physics.scene

@@ -6,6 +6,8 @@
 * :func:`hold`: a lock (``PATH.lock``, ``fcntl.flock``) refuses a second writer of the same
   path, from this or another process, at once. The OS drops the lock of a process that
   dies, so a lock file left by a killed one blocks nothing; a released lock file is removed.
+* :func:`check_outputs` checks a run's output paths before any work; :func:`write_outputs`
+  writes each on its own at the end, one failure not stopping the others.
 * :func:`guarded`: a run (a stepping loop) checks and locks its outputs before any work and,
   within it, SIGTERM takes Ctrl-C's path: the run stops and writes what it simulated.
 """
@@ -20,8 +22,9 @@ import signal
 import threading
 from contextlib import ExitStack, contextmanager
 from pathlib import Path
+from typing import Dict, Optional
 
-from .errors import ParameterError, sigterm_as_interrupt
+from .errors import OutputError, ParameterError, sigterm_as_interrupt
 
 _held: dict = {}                       # real path -> [(pid, thread), count, fd]
 _held_lock = threading.Lock()
@@ -171,9 +174,8 @@ def replacing(path, name: str = "path"):
 @contextmanager
 def run_guard(**paths):
     """The block of a run that writes ``paths`` (name -> path or None): they are checked
-    (:func:`mjeap.rollout.check_outputs`) and locked before it starts, and SIGTERM raises
+    (:func:`check_outputs`) and locked before it starts, and SIGTERM raises
     :class:`~mjeap.errors.Terminated` (a KeyboardInterrupt) within it, as Ctrl-C does."""
-    from .rollout import check_outputs
     with ExitStack() as stack:
         out = check_outputs(**paths)
         for name, p in out.items():
@@ -204,3 +206,52 @@ def provenance() -> dict:
     import mujoco
     from . import __version__
     return {"mujoco": mujoco.__version__, "mjeap": __version__}
+
+
+def check_outputs(**paths) -> Dict[str, Path]:
+    """The outputs a run will write (name -> path or None), checked before any work: distinct
+    files, not directories, in a folder that exists or can be made and is writable."""
+    out, seen = {}, {}
+    for name, p in paths.items():
+        if p is None:
+            continue
+        p = Path(p)
+        key = p.resolve()
+        if key in seen:
+            raise ParameterError(name, str(p), f"a file other than the {seen[key]} output's")
+        seen[key] = name
+        if p.is_dir():
+            raise ParameterError(name, str(p), "a file path (it is a directory)")
+        parent = p.parent
+        try:
+            parent.mkdir(parents=True, exist_ok=True)
+        except OSError as e:
+            raise ParameterError(name, str(p), "a path in a folder that exists or can be made",
+                                 f"cannot write {p}: {e.strerror or e}") from None
+        if not os.access(parent, os.W_OK) or (p.exists() and not os.access(p, os.W_OK)):
+            raise ParameterError(name, str(p), "a writable path", f"cannot write {p}: permission denied")
+        out[name] = p
+    return out
+
+
+def write_outputs(writers, error: Optional[BaseException], result=None) -> None:
+    """Run each ``(path, write)`` on its own: one failing write does not stop the others.
+    The run's own error stays the error raised (the write failures are added to its notes);
+    without one, the failures raise :class:`OutputError` carrying the result. Ctrl-C and
+    SIGTERM wait until all are written."""
+    failures = []
+    with deferred_signals():
+        for path, write in writers:
+            try:
+                write()
+            except Exception as e:                   # noqa: BLE001 - reported, never masks the run's error
+                failures.append((path, f"{type(e).__name__}: {e}"))
+    if not failures:
+        return
+    if error is not None:
+        notes = getattr(error, "__notes__", None)
+        if notes is None:
+            notes = error.__notes__ = []
+        notes.extend(f"cannot write {p}: {why}" for p, why in failures)
+        return
+    raise OutputError(failures, result)

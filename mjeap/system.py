@@ -33,7 +33,7 @@ from .component import ActuatorPart
 from .errors import DivergenceError, ParameterError, UnknownNameError, check_positive
 from .outputs import guarded, provenance
 from .versions import newton_sparse_broken
-from .rollout import one_voltage
+from .engines.frame import one_voltage
 from .scene import DEFAULT_SEGMENTS, INTEGRATORS, Scene, apply_dof_damping, diverged
 from .units import DEFAULT_UNITS, UnitSystem
 
@@ -483,7 +483,7 @@ class System:
         k0 = self._per_actuator("initial_curvatures", initial_curvatures)
         m, d = self.model, self.data
         mujoco.mj_resetData(m, d)
-        from .rollout import check_initial_curvature
+        from .engines.frame import check_initial_curvature
         for p, k in zip(self.parts, k0):
             p.apply_loads()
             k = check_initial_curvature(k, p.layout.length, "initial_curvatures")
@@ -607,7 +607,8 @@ class System:
         hold over it, one per actuator or a dict by prefix (None: unchanged); each is checked
         against its drive's safe range. It may read the system's state; a controller that
         senses an actuator's current steps a :meth:`drive_observer` with them."""
-        from .rollout import _Samples, _sample_steps, _voltage_steps, _waveform, check_work, write_outputs
+        from .engines.frame import Samples, check_work, lockstep, sample_steps as steps_of, to_waveform, voltage_steps
+        from .outputs import write_outputs
         duration = check_positive("duration", duration, "s")
         if controller is not None:
             if voltages is not None and any(v is not None for v in self._per_actuator("voltages", voltages)):
@@ -615,7 +616,7 @@ class System:
             if not callable(controller):
                 raise ParameterError("controller", controller, "a callable controller(t, system) -> voltages")
             voltages = None
-        waves = [None if w is None else _waveform(w, duration) for w in self._per_actuator("voltages", voltages)]
+        waves = [None if w is None else to_waveform(w, duration) for w in self._per_actuator("voltages", voltages)]
         dt = self.timestep
         n_steps = check_work(duration, dt)
         v_steps = []
@@ -627,10 +628,10 @@ class System:
                 continue
             # a waveform is checked against the drive's safe range there; the rest voltage is in it
             v_steps.append(np.full(n_steps, a.drive.rest_voltage()) if w is None else
-                           _voltage_steps(w, duration, dt, a.drive))
-        sample_steps = _sample_steps(n_steps, dt, sample_interval)
+                           voltage_steps(w, duration, dt, a.drive))
+        sample_steps = steps_of(n_steps, dt, sample_interval)
         ns = len(sample_steps)
-        samples = [_Samples(p, ns) for p in self.parts]
+        samples = [Samples(p, ns) for p in self.parts]
         nb = self.model.nbody
         pos, quat, fc = np.empty((ns, nb, 3)), np.empty((ns, nb, 4)), np.empty((ns, nb, 3))
         m, d = self.model, self.data
@@ -666,23 +667,21 @@ class System:
 
         error = None
         wall0 = _time.perf_counter()
+        def before(k):
+            if controller is not None and k:
+                self._control(controller(k * dt, self), v_steps, k, ctrl_name)
+            for i, v in active:
+                d.ctrl[i] = v[k]
+
+        def check(done, k):
+            self._step_count = done
+            self.check_finite()
+
         try:
             if controller is not None:          # the voltage over step 0 is the first sample's
                 self._control(controller(0.0, self), v_steps, 0, ctrl_name)
-            sample(0, 0)
-            nxt = 1
-            for k in range(n_steps):
-                if controller is not None and k:
-                    self._control(controller(k * dt, self), v_steps, k, ctrl_name)
-                for i, v in active:
-                    d.ctrl[i] = v[k]
-                mujoco.mj_step(m, d)
-                self._step_count = k + 1
-                if (k + 1) % 100 == 0 or (nxt < ns and k + 1 == sample_steps[nxt]):
-                    self.check_finite()
-                if nxt < ns and k + 1 == sample_steps[nxt]:
-                    sample(nxt, k + 1)
-                    nxt += 1
+            lockstep(m, d, n_steps, sample_steps, before, sample, check)
+            self._step_count = n_steps
         except BaseException as e:
             error = e
             raise

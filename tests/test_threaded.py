@@ -1,4 +1,4 @@
-"""MuJoCo's native threaded rollout (mjeap.threaded) against the lockstep loop.
+"""MuJoCo's native threaded rollout (mjeap.engines.threaded) against the lockstep loop.
 
 The reference is the loop engine itself: both step the same model with the same moments,
 so the trajectories, drive signals and final states must agree to round-off (1e-12 of
@@ -10,7 +10,7 @@ import pytest
 from mjeap import Scene
 from mjeap.errors import DivergenceError, ParameterError
 from mjeap.rollout import rollout, rollout_batch
-from mjeap import threaded
+from mjeap.engines import threaded
 
 OPEN_LOOP = [
     ("pzt-hamr-small", "hinge", "sine:20V@500Hz,offset=100V", 0.01, {}),

@@ -212,7 +212,7 @@ class Drive:
                                  f"values in the safe range [{lo:g}, {hi:g}] V of {self.scene.actuator.id} "
                                  f"under {self.name}")
 
-    # -- open loop (MuJoCo's threaded rollout, mjeap.threaded) ---------------------------
+    # -- open loop (MuJoCo's threaded rollout, mjeap.engines.threaded) ---------------------------
     def closed_loop_reason(self) -> Optional[str]:
         """None where the moments follow from the voltage alone and the drive leaves the
         model unchanged, so their history can be computed before the run; else why not."""

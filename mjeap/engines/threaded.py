@@ -1,4 +1,4 @@
-"""Open-loop rollouts on MuJoCo's native threaded rollout (``mujoco.rollout``).
+"""The ``threaded`` engine: open-loop rollouts on MuJoCo's threaded rollout (``mujoco.rollout``).
 
 When it applies (:func:`why_not` says why not otherwise):
 
@@ -25,8 +25,8 @@ import mujoco
 import numpy as np
 from mujoco import rollout as mj_rollout
 
-from .drives.base import Drive
-from .errors import DivergenceError
+from ..errors import DivergenceError
+from . import Engine
 
 STATE = mujoco.mjtState.mjSTATE_FULLPHYSICS
 CONTROL = mujoco.mjtState.mjSTATE_QFRC_APPLIED
@@ -153,66 +153,14 @@ def raise_bad(scene, put, drives, v_steps, bad) -> None:
     raise _error(scene, drives[b], v_steps[b][step - 1], b, B)
 
 
-def run_native(scene, native, drives: Sequence, v_steps: Sequence[np.ndarray], initial_curvatures: Sequence[float],
-               sample_steps: np.ndarray, samples: Sequence, nthread: int = 0) -> None:
-    """As :func:`run`, on the scene's native model (:class:`mjeap.native.NativeModel`): the
-    controls are the voltages themselves (the actuator's ctrl), the drive runs inside
-    MuJoCo. The scene is left in the final state of the last run (its beam dofs)."""
-    m, d, part, h = native.model, native.data, native.part, native.handles
-    B, n = len(drives), len(v_steps[0])
-    dt, a = scene.timestep, native.actuator_id
-    state0 = np.empty((B, mujoco.mj_stateSize(m, STATE)))
-    # the controls: the voltage (ctrl), and the tip loads where the scene has them
-    spec = NATIVE_CONTROL | (LOADS if scene.part.has_tip_load() else 0)
-    template = np.empty(mujoco.mj_stateSize(m, spec))
-    for drv in drives:          # the drives' signals read the native model's state
-        drv.part = part
-    # drives that compute their signals from the states at the end keep those rows
-    batch = [type(drv).native_signal_history is not Drive.native_signal_history for drv in drives]
-    rows = [np.empty((len(sample_steps), state0.shape[1])) if bt else None for bt in batch]
-    for b in range(B):
-        native.drive = drives[b]
-        native.reset(initial_curvatures[b])
-        mujoco.mj_getState(m, d, state0[b], STATE)
-        mujoco.mj_getState(m, d, template, spec)
-        drives[b].native_prepare(v_steps[b])
-        if batch[b]:
-            rows[b][0] = state0[b]
-        samples[b].take(0.0, v_steps[b][0], {} if batch[b] else drives[b].native_signals(0, part, h))
+class ThreadedEngine(Engine):
+    """Open-loop drives on ``mujoco.rollout``: the moments as qfrc_applied controls."""
 
-    def controls(s0, c, out):
-        out[:] = template
-        for b in range(B):
-            out[b][:, a] = v_steps[b][s0:s0 + c]     # ctrl comes first in a composite state
+    name, batched = "threaded", True
 
-    def put(state):
-        mujoco.mj_setState(m, d, state, STATE)
-        mujoco.mj_kinematics(m, d)
-        sd, nq, nv = scene.data, scene.model.nq, scene.model.nv     # the beam's dofs come first
-        sd.qpos[:], sd.qvel[:], sd.time = d.qpos[:nq], d.qvel[:nv], d.time
-        scene.update_kinematics()
+    def why_not(self, scene, drive, controller=None) -> Optional[str]:
+        return why_not(scene, drive, controller)
 
-    def take(b, k, state):
-        mujoco.mj_setState(m, d, state, STATE)
-        mujoco.mj_kinematics(m, d)
-        if batch[b]:
-            rows[b][samples[b].n] = state
-        samples[b].take(k * dt, v_steps[b][k - 1], {} if batch[b] else drives[b].native_signals(k, part, h))
-
-    try:
-        final, bad = roll(m, state0, controls, len(template), spec, n, sample_steps, take, nthread)
-        if bad is not None:
-            raise_bad(scene, put, drives, v_steps, bad)
-        put(final[-1])
-    finally:
-        for b in range(B):
-            if batch[b]:
-                n_b = samples[b].n
-                samples[b].sig = drives[b].native_signal_history(sample_steps[:n_b], rows[b][:n_b], part, h)
-        for drv in drives:
-            drv.part = scene.part
-    # the scene and the (last) drive as the loop leaves them: final state, last moments applied
-    mujoco.mj_setState(m, d, final[-1], STATE)
-    mujoco.mj_kinematics(m, d)
-    drives[-1].native_leave(n, part, h)
-    scene._step_count = n
+    def run(self, scene, drives, v_steps, initial_curvatures, sample_steps, samples, *, nthread=0, progress=None,
+            check_every=100, controller=None, meta=None) -> None:
+        run(scene, drives, v_steps, initial_curvatures, sample_steps, samples, nthread=nthread)

@@ -1,0 +1,109 @@
+"""Engines: the ways a run is stepped, behind one small interface and one registry.
+
+An :class:`Engine` says whether it applies to a run (:meth:`Engine.why_not`: None, or the
+reason in words), which actuator part its samples read (:meth:`Engine.part`) and runs it
+(:meth:`Engine.run`) into sample stores of :mod:`mjeap.engines.frame`. :func:`choose` is
+the one place a run picks its engine: :func:`mjeap.rollout`, :func:`mjeap.rollout_batch`,
+:meth:`mjeap.System.rollout` and the environments go through it. Registered here:
+
+* ``native``: the drive compiled into the model (:mod:`mjeap.native`), stepped by
+  ``mujoco.rollout`` in C, batches over threads;
+* ``threaded``: an open-loop drive's moment history computed up front, applied by
+  ``mujoco.rollout`` (:mod:`mjeap.engines.threaded`);
+* ``loop``: the drive, then ``mj_step``, once per step from Python; serves every drive and
+  closed-loop controllers (:mod:`mjeap.engines.loop`).
+
+``auto`` takes the first that applies in that order. A new engine (a batched GPU one, say)
+is one module that calls :func:`register_engine`.
+"""
+from __future__ import annotations
+
+from typing import Dict, List, Optional, Sequence, Tuple
+
+from ..errors import ParameterError
+
+__all__ = ["Engine", "register_engine", "get_engine", "engine_names", "choose", "ENGINES"]
+
+
+class Engine:
+    """One way of stepping a run of a scene (internal units, the scene's timestep)."""
+
+    #: registry name
+    name: str = ""
+    #: runs several rollouts in one call (``rollout_batch``)
+    batched: bool = False
+
+    def why_not(self, scene, drive, controller=None) -> Optional[str]:
+        """None where this engine applies to a run of ``scene`` with ``drive`` (and
+        ``controller``); else the reason, in words."""
+        return None
+
+    def part(self, scene, drive):
+        """The actuator part (:class:`mjeap.component.ActuatorPart`) whose state the samples
+        read: the scene's own unless the engine steps another model."""
+        return scene.part
+
+    def run(self, scene, drives: Sequence, v_steps: Sequence, initial_curvatures: Sequence[float], sample_steps,
+            samples: Sequence, *, nthread: int = 0, progress: Optional[bool] = None, check_every: int = 100,
+            controller=None, meta: Optional[dict] = None) -> None:
+        """Roll out one run per drive (its voltage per step, initial curvature 1/m and sample
+        store), filling the stores; raises DivergenceError at the first diverged state and
+        leaves the scene in the final state of the last run."""
+        raise NotImplementedError
+
+
+_REGISTRY: Dict[str, Engine] = {}
+
+
+def register_engine(engine: Engine) -> Engine:
+    """Add ``engine`` under its name; :func:`choose`'s ``auto`` tries engines in the order
+    they were registered."""
+    _REGISTRY[engine.name] = engine
+    return engine
+
+
+def engine_names() -> List[str]:
+    """The registered engines, in ``auto``'s order of preference."""
+    return list(_REGISTRY)
+
+
+def get_engine(name: str) -> Engine:
+    """The engine registered as ``name``."""
+    if name not in _REGISTRY:
+        raise ParameterError("engine", name, f"one of auto, {', '.join(_REGISTRY)}")
+    return _REGISTRY[name]
+
+
+def choose(name: str, scene, drive, controller=None, batched: bool = False) -> Tuple[Engine, str]:
+    """The engine for a run and why: ``name`` if it applies (refused with its reason if
+    not), or with ``auto`` the first registered one that applies (``batched``: among those
+    that run batches, refused naming each one's reason where none does)."""
+    if name != "auto":
+        engine = get_engine(name)
+        why = "it runs one rollout at a time (rollout_batch needs a batched engine)" \
+            if batched and not engine.batched else engine.why_not(scene, drive, controller)
+        if why is not None:
+            ok = "'auto'" if batched else "'loop' or 'auto'"
+            raise ParameterError("engine", name, f"{ok} for this run: {why}")
+        return engine, "asked for"
+    tried = []
+    for engine in _REGISTRY.values():
+        if batched and not engine.batched:
+            continue
+        why = engine.why_not(scene, drive, controller)
+        if why is None:
+            return engine, "; ".join(["auto"] + tried)
+        tried.append(f"not {engine.name}: {why}")
+    if batched:
+        raise ParameterError("engine", "auto", "an engine that runs this batch: " + "; ".join(tried),
+                             "rollout_batch needs the native or threaded engine; run the loop engine per rollout")
+    raise ParameterError("engine", name, "an engine that applies: " + "; ".join(tried))   # pragma: no cover
+
+
+from . import native as _native, threaded as _threaded, loop as _loop  # noqa: E402  registration order = auto's
+
+register_engine(_native.NativeEngine())
+register_engine(_threaded.ThreadedEngine())
+register_engine(_loop.LoopEngine())
+#: the engine names a run accepts
+ENGINES = ("auto", *engine_names())

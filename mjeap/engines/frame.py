@@ -1,0 +1,271 @@
+"""The stepping frame every engine shares (:mod:`mjeap.engines`): the run's work and
+sampling checked before it starts, the voltage history, the sample store of one actuator
+and the SI result, and :func:`lockstep`, the loop that steps a model from Python.
+
+A sample copies MuJoCo's raw world positions and the drive's signals; the SI read-outs
+(clamp frame, tip angle, arc curvature) are computed for all samples at once at the end.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable, Dict, Optional, Union
+
+import mujoco
+import numpy as np
+
+from .. import csvio
+from ..analytical import arc_curvature
+from ..errors import ParameterError, check_range
+from ..outputs import replacing
+from ..waveforms import Waveform, parse_waveform
+
+__all__ = ["RolloutResult", "Samples", "MAX_STEPS", "DEFAULT_SAMPLES", "check_work", "check_sampling",
+           "voltage_steps", "to_waveform", "one_voltage", "check_initial_curvature", "sample_steps", "lockstep"]
+
+#: at most this many samples are kept per rollout unless sample_interval is given
+DEFAULT_SAMPLES = 5000
+
+
+@dataclass
+class RolloutResult:
+    """Sampled SI arrays of a rollout. Positions are in the clamp frame (x along the
+    undeformed beam, y the deflection, z out of the bending plane). Sample i is the state
+    after step k; its voltage is the one held over that step (zero-order hold), the same
+    instant the drive signals describe."""
+
+    time: np.ndarray                 # (n,) s
+    voltage: np.ndarray              # (n,) V
+    tip_position: np.ndarray         # (n, 3) m
+    tip_angle: np.ndarray            # (n,) rad
+    tip_curvature: np.ndarray        # (n,) 1/m, arc through clamp and tip (seed 000)
+    centreline: np.ndarray           # (n, N + 2, 3) m
+    payload_position: Optional[np.ndarray]
+    signals: Dict[str, np.ndarray]   # drive quantities, 'name (unit)'
+    reference_curvature: Optional[np.ndarray]
+    meta: dict = field(default_factory=dict)
+
+    def peak_to_peak(self, key: str = "tip_curvature", t_from: float = 0.0) -> float:
+        y = getattr(self, key) if hasattr(self, key) else self.signals[key]
+        sel = self.time >= t_from
+        return float(np.max(y[sel]) - np.min(y[sel]))
+
+    def to_csv(self, path: Union[str, Path]) -> None:
+        """Time series (no centreline) as CSV with SI units in the header, written whole
+        (:func:`mjeap.outputs.replacing`) and spreadsheet-safe (:class:`mjeap.csvio.writer`)."""
+        cols = {"time (s)": self.time, "voltage (V)": self.voltage,
+                "tip_x (m)": self.tip_position[:, 0], "tip_y (m)": self.tip_position[:, 1],
+                "tip_z (m)": self.tip_position[:, 2], "tip_angle (rad)": self.tip_angle,
+                "tip_curvature (1/m)": self.tip_curvature, **self.signals}
+        if self.reference_curvature is not None:
+            cols["reference_curvature (1/m)"] = self.reference_curvature
+        with replacing(path, "csv_path") as tmp, open(tmp, "w", newline="") as fh:
+            w = csvio.writer(fh)
+            w.writerow(cols)
+            w.writerows(np.column_stack([np.asarray(c, dtype=float) for c in cols.values()]))
+
+
+class Samples:
+    """Preallocated sample arrays of one rollout of one actuator (an
+    :class:`~mjeap.component.ActuatorPart`). A sample copies MuJoCo's raw world positions
+    (clamp, links, payload, tip site), the tip's orientation (and the clamp's, where the
+    clamp can move) and the drive's signals; the clamp-frame SI read-outs (the part's
+    clamp_frame and in_plane_angle, as its own read-outs use) are computed for all samples
+    at once at the end, so a sample costs a few copies."""
+
+    def __init__(self, part, ns: int):
+        self.part, self.ns = part, ns
+        N = part.layout.segments
+        # raw world points per sample: clamp, the N link origins, the tip site, the payload
+        self._bodies = np.r_[part.clamp_id, part.link_ids].astype(np.intp)
+        self._raw = np.empty((ns, N + 2 + (part.payload_id >= 0), 3))
+        self._xmat = np.empty((ns, 9))
+        self._moving = part._fixed_rotation is None
+        self._clamp_xmat = np.empty((ns, 9)) if self._moving else None
+        self.t, self.v = np.empty(ns), np.empty(ns)
+        self.sig: Dict[str, np.ndarray] = {}
+        self.n = 0                                  # samples taken
+
+    def _put(self, key, i, value):
+        if key not in self.sig:
+            self.sig[key] = np.full(self.ns, np.nan)
+        self.sig[key][i] = value
+
+    def take(self, t: float, v: float, signals: Dict[str, float], controller=None) -> None:
+        """Sample the state after the step that ended at ``t`` s (kinematics up to date),
+        ``v`` the voltage held over that step (the first sample: the first step's), the
+        instant the drive's ``signals`` describe."""
+        p, i = self.part, self.n
+        d = p.data
+        self.t[i], self.v[i] = t, v
+        raw, N = self._raw[i], p.layout.segments
+        np.take(d.xpos, self._bodies, axis=0, out=raw[:N + 1], mode="clip")
+        raw[N + 1] = d.site_xpos[p.tip_site_id]
+        if p.payload_id >= 0:
+            raw[N + 2] = d.xpos[p.payload_id]
+        self._xmat[i] = d.xmat[p.tip_body_id]
+        if self._moving:
+            self._clamp_xmat[i] = d.xmat[p.clamp_id]
+        for k, x in signals.items():
+            self._put(k, i, x)
+        if controller is not None and hasattr(controller, "signals"):
+            for k, x in controller.signals().items():
+                self._put(f"controller_{k}", i, x)
+        self.n += 1
+
+    def _to_clamp(self, raw: np.ndarray, xmat: np.ndarray):
+        """Clamp-frame points (m) and tip angles (rad) of raw samples."""
+        p = self.part
+        if not self._moving:
+            return p.clamp_frame(raw), p.in_plane_angle(xmat)
+        R = self._clamp_xmat[:len(raw)].reshape(-1, 3, 3)
+        pts = np.einsum("n...j,njk->n...k", raw, R) * p.units.length
+        rel = np.einsum("nji,njk->nik", R, xmat.reshape(-1, 3, 3))
+        return pts, np.arctan2(rel[:, 1, 0], rel[:, 0, 0])
+
+    def result(self, drive, initial_curvature: float, meta: dict) -> RolloutResult:
+        """The SI result; called once, at the end (it works on the raw arrays in place)."""
+        n, p = self.n, self.part
+        N = p.layout.segments
+        raw = self._raw[:n]
+        raw -= raw[:, :1].copy()                    # relative to the clamp (in place)
+        pts, ang = self._to_clamp(raw, self._xmat[:n])
+        cl = pts[:, :N + 2]                         # clamp, hinges, tip
+        tip = cl[:, -1].copy()                      # the centreline ends at the tip point
+        kap = arc_curvature(tip[:, 0], tip[:, 1])
+        pay = pts[:, N + 2] if p.payload_id >= 0 else None
+        ref = drive.reference_curvature(self.t[:n], self.v[:n], initial_curvature) \
+            if (n > 1 and drive is not None) else None
+        return RolloutResult(self.t[:n], self.v[:n], tip, ang, kap, cl, pay,
+                             {k: x[:n] for k, x in self.sig.items()}, ref, meta)
+
+
+#: runs of more steps are refused unless ``max_steps`` is raised (the voltage history alone
+#: takes 8 bytes a step; at ~10-30 us a step this is minutes of work)
+MAX_STEPS = 20_000_000
+#: a waveform whose energy above the step's Nyquist frequency exceeds this fraction is refused
+ALIASED_ENERGY = 1e-3
+
+
+def check_work(duration: float, dt: float, max_steps: Optional[int] = None) -> int:
+    """The number of steps of a run, refused before any work where the duration is shorter
+    than one timestep or the steps exceed ``max_steps`` (default MAX_STEPS)."""
+    limit = MAX_STEPS if max_steps is None else int(max_steps)
+    if duration < dt:
+        raise ParameterError("duration", f"{duration:g} s", f"at least one timestep ({dt:.4g} s)")
+    n = int(round(duration / dt))
+    if n > limit:
+        raise ParameterError("duration", f"{duration:g} s", f"at most {limit:,} steps of {dt:.4g} s "
+                             f"({limit * dt:.4g} s); this run needs {n:,} steps and {8 * n / 2**20:.0f} MiB for its "
+                             "voltage history alone. Raise max_steps (--max-steps) to run it")
+    return n
+
+
+def check_sampling(wave, dt: float) -> None:
+    """Refuse a waveform whose content the step cannot represent: a frequency at or above
+    the Nyquist frequency 1/(2 dt) (a sine of 13 kHz at dt = 77 us runs as an aliased
+    38 Hz one), or csv samples with more than ALIASED_ENERGY of their energy above it."""
+    if not isinstance(wave, Waveform):
+        return
+    f_n = 0.5 / dt
+    above = wave.content_above(f_n)
+    if above > (ALIASED_ENERGY if wave.kind == "csv" else 0.0):
+        what = (f"{above:.1%} of the csv signal's energy lies above" if wave.kind == "csv"
+                else f"frequency {wave.max_frequency:g} Hz is at or above")
+        raise ParameterError("voltage", getattr(wave, "text", str(wave)),
+                             f"content below the Nyquist frequency {f_n:.4g} Hz of the timestep {dt:.4g} s "
+                             f"({what} it and would alias)", "pass a smaller timestep to the Scene")
+
+
+def voltage_steps(wave, duration: float, dt: float, drive, max_steps: Optional[int] = None) -> np.ndarray:
+    n_steps = check_work(duration, dt, max_steps)
+    check_sampling(wave, dt)
+    t_steps = np.arange(n_steps) * dt
+    v = np.zeros(n_steps) if wave is None else np.asarray(wave(t_steps), dtype=float) * np.ones(n_steps)
+    drive.check_voltage(v)
+    return v
+
+
+def to_waveform(voltage, duration: float):
+    """A waveform from text, a :class:`Waveform`, a number (a constant voltage, V) or a
+    callable v(t); anything else is refused naming what is accepted."""
+    if isinstance(voltage, bool) or voltage is None:
+        raise ParameterError("voltage", voltage, "a waveform ('step:1V', 'sine:1V@2Hz', ...), a number of volts "
+                             "or a callable v(t); None only with a controller")
+    if isinstance(voltage, (int, float, np.number)):
+        v = float(voltage)
+        if not math.isfinite(v):
+            raise ParameterError("voltage", voltage, "a finite number of volts")
+        voltage = Waveform("step", amplitude=v, text=f"constant {v:g} V")
+    if not isinstance(voltage, (str, Waveform)) and not callable(voltage):
+        raise ParameterError("voltage", voltage, "a waveform text, a Waveform, a number of volts or a callable v(t)")
+    wave = parse_waveform(voltage) if isinstance(voltage, str) else voltage
+    return wave.with_duration(duration) if isinstance(wave, Waveform) else wave
+
+
+def one_voltage(value, name: str, where: str = "") -> float:
+    """A policy's or controller's command for one actuator as a voltage (V): a finite real
+    number or a one-element array (shape (1,), a dm_env action). Text, None, a bool, more
+    values (two for one actuator, never cut to the first), none or NaN/inf are refused
+    naming ``name``, the shape expected and ``where`` (the controller and time). The one
+    check of every command path (:func:`rollout`'s loop, :class:`mjeap.system.System`,
+    the dm_env environment)."""
+    try:
+        a = None if isinstance(value, (str, bytes, bool, type(None))) else np.asarray(value)
+    except (TypeError, ValueError):          # ragged nesting
+        a = None
+    ok = a is not None and a.size == 1 and a.dtype.kind in "iuf"
+    v = float(a.reshape(-1)[0]) if ok else math.nan
+    if not math.isfinite(v):
+        shown = value if ok or a is None or a.ndim == 0 else f"{type(value).__name__} of shape {a.shape}"
+        raise ParameterError(name, shown, "one number, a finite voltage in V for one actuator (a number or an "
+                             "array of shape (1,))", where)
+    return v
+
+
+#: the largest initial bend accepted: a uniform arc closing into a full circle
+MAX_INITIAL_BEND = 2 * np.pi
+
+
+def check_initial_curvature(kappa, length: float, name: str = "initial_curvature") -> float:
+    """A finite initial curvature (1/m) whose arc bends at most MAX_INITIAL_BEND over the
+    beam (|kappa| L <= 2 pi: a full circle; more wraps the beam around itself)."""
+    return check_range(name, kappa, -MAX_INITIAL_BEND / length, MAX_INITIAL_BEND / length, "1/m")
+
+
+def sample_steps(n_steps: int, dt: float, sample_interval: Optional[float]) -> np.ndarray:
+    """The steps after which a sample is taken: every ``sample_interval`` (rounded to whole
+    steps) or, by default, every ceil(n / DEFAULT_SAMPLES) steps: at most DEFAULT_SAMPLES + 1
+    samples with the initial state, evenly spaced (the analytical references integrate on
+    them), the last within one interval of the end (the scene holds the final state)."""
+    every = max(1, int(round(sample_interval / dt))) if sample_interval else max(1, -(-n_steps // DEFAULT_SAMPLES))
+    return np.arange(0, n_steps + 1, every)
+
+
+def lockstep(model, data, n_steps: int, steps: np.ndarray, before: Callable[[int], None],
+             sample: Callable[[int, int], None], check: Callable[[int, int], None], check_every: int = 100,
+             progress: Optional[Callable[[int], None]] = None) -> None:
+    """Step ``model`` ``n_steps`` times from Python, the frame of the loop engine and of
+    :meth:`mjeap.System.rollout`: ``before(k)`` sets what acts over step k (a drive's
+    moments, the actuators' ctrl), then ``mj_step``; ``check(k + 1, k)`` after every
+    ``check_every``-th step and at each sample step raises on a diverged state;
+    ``sample(i, k)`` samples the state after step k = ``steps[i]`` (``steps[0]`` = 0 first);
+    ``progress(n)`` is told of n more steps at each sample."""
+    step_fn = mujoco.mj_step
+    ns = len(steps)
+    sample(0, 0)
+    i, nxt = 1, (int(steps[1]) if ns > 1 else n_steps + 1)
+    last = 0
+    for k in range(n_steps):
+        before(k)
+        step_fn(model, data)
+        if (k + 1) % check_every == 0 or k + 1 == nxt:
+            check(k + 1, k)
+        if k + 1 == nxt:
+            sample(i, k + 1)
+            i += 1
+            nxt = int(steps[i]) if i < ns else n_steps + 1
+            if progress is not None:
+                progress(k + 1 - last)
+                last = k + 1

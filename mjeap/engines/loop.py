@@ -1,0 +1,112 @@
+"""The ``loop`` engine: the drive, then ``mj_step``, once per step from Python
+(:func:`mjeap.engines.frame.lockstep`). It serves every drive and closed-loop controllers.
+
+Why not MuJoCo's ``mjcb_control`` hook: that callback is one global per process (two
+scenes, or a scene and an environment, would fight over it) and costs a C-to-Python call
+per step anyway.
+"""
+from __future__ import annotations
+
+import math
+import sys
+
+import mujoco
+import numpy as np
+
+from ..errors import DivergenceError
+from . import Engine
+from .frame import lockstep, one_voltage
+
+try:  # progress bars are optional
+    from tqdm import tqdm
+except ImportError:  # pragma: no cover
+    tqdm = None
+
+#: runs of more steps show a progress bar (when progress is None)
+PROGRESS_STEPS = 200_000
+
+
+def advance(model, data, drive, voltage: float, dt: float, nstep: int = 1) -> None:
+    """``nstep`` lockstep steps at a held ``voltage`` (V): the drive's step of ``dt`` s, then
+    MuJoCo's; the environments' step."""
+    for _ in range(nstep):
+        drive.step(voltage, dt)
+        mujoco.mj_step(model, data)
+
+
+class LoopEngine(Engine):
+    """Every drive, open or closed loop, one run at a time."""
+
+    name, batched = "loop", False
+
+    def run(self, scene, drives, v_steps, initial_curvatures, sample_steps, samples, *, nthread=0, progress=None,
+            check_every=100, controller=None, meta=None) -> None:
+        (drv,), (v,), (kappa0,), (store,) = drives, v_steps, initial_curvatures, samples
+        run_loop(scene, drv, v, kappa0, sample_steps, store, progress, check_every, controller,
+                 {} if meta is None else meta)
+
+
+def run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, progress, check_every,
+             controller, meta) -> None:
+    """One lockstep run of ``scene`` with ``drv``: ``v_steps`` (V per step; a controller's
+    commands are written into it), sampled at ``sample_steps`` into ``samples``."""
+    dt, n_steps = scene.timestep, len(v_steps)
+    scene.reset(curvature=initial_curvature)
+    drv.reset(initial_curvature)
+    ctrl_every, (v_lo, v_hi) = n_steps + 1, drv.voltage_range()
+    state = {"saturated": 0, "hold": 0.0}
+    ctrl_name = None
+    if controller is not None:
+        controller.reset(scene, drv)
+        ctrl_every = max(1, int(round(getattr(controller, "interval", dt) / dt)))
+        ctrl_name = meta["controller"]
+    show = (n_steps > PROGRESS_STEPS and sys.stderr.isatty()) if progress is None else progress
+    bar = tqdm(total=n_steps, unit="step", desc=f"{scene.actuator.id} {drv.name}", disable=not show,
+               leave=False) if tqdm else None
+    m, d = scene.model, scene.data
+    drive_step = drv.step
+
+    def before(k):
+        if controller is not None:
+            if k % ctrl_every == 0:
+                scene.update_kinematics()
+                u = controller(k * dt, scene)
+                if not isinstance(u, float) or not math.isfinite(u):
+                    u = one_voltage(u, "controller command", f"{ctrl_name} at t = {k * dt:.6g} s")
+                state["hold"] = min(max(u, v_lo), v_hi)
+                state["saturated"] += state["hold"] != u
+            v_steps[k] = state["hold"]
+        drive_step(v_steps[k], dt)
+
+    def sample(i, step):
+        scene.update_kinematics()
+        samples.take(step * dt, state["hold"] if controller is not None else v_steps[max(step - 1, 0)],
+                     drv.signals(), controller)
+
+    def check(done, k):
+        try:
+            scene._step_count = done
+            scene.check_finite()
+        except DivergenceError as e:
+            bad = d.qfrc_applied[~np.isfinite(d.qfrc_applied)]
+            if bad.size:                 # the drive's own output, not the timestep
+                raise DivergenceError(
+                    f"the drive {drv.describe()} applied a non-finite moment ({bad[0]}) by t = "
+                    f"{done * dt:.6g} s (step {done}), voltage {v_steps[k]:.4g} V; the beam was finite "
+                    "until then: check the drive, not the timestep") from None
+            who = f" Controller: {ctrl_name} (check its gains)." if controller is not None else ""
+            raise DivergenceError(f"{e} Drive: {drv.describe()}, voltage {v_steps[k]:.4g} V.{who}") from None
+
+    try:
+        lockstep(m, d, n_steps, sample_steps, before, sample, check, check_every,
+                 None if bar is None else bar.update)
+    finally:
+        if bar is not None:
+            bar.close()
+        if controller is not None:
+            saturated = state["saturated"]
+            meta["saturated_updates"] = int(saturated)
+            if saturated:
+                meta.setdefault("warnings", []).append(
+                    f"{ctrl_name}: {saturated} voltage commands clipped to the safe range [{v_lo:g}, {v_hi:g}] V "
+                    "(reference beyond reach or gains too high)")
