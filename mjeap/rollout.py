@@ -456,6 +456,21 @@ def _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, 
     return result
 
 
+def divergence_error(scene, drv, voltage: float, step: int, who: str = "") -> DivergenceError:
+    """The error of a lockstep run of ``scene`` and ``drv`` that blew up by ``step`` (the
+    last with ``voltage`` V held): a drive whose own moment is not finite is named as the
+    cause, else the scene's error (timestep against its stability limit) with the drive and
+    voltage, and ``who`` (a controller) added."""
+    d = scene.data
+    bad = d.qfrc_applied[~np.isfinite(d.qfrc_applied)]
+    if bad.size:                 # the drive's own output, not the timestep
+        return DivergenceError(
+            f"the drive {drv.describe()} applied a non-finite moment ({bad[0]}) by t = "
+            f"{step * scene.timestep:.6g} s (step {step}), voltage {voltage:.4g} V; the beam was finite "
+            "until then: check the drive, not the timestep")
+    return DivergenceError(f"{scene.divergence_error()} Drive: {drv.describe()}, voltage {voltage:.4g} V.{who}")
+
+
 def _run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, progress, check_every,
               controller, meta) -> None:
     """The lockstep engine: drive, then mj_step, once per step."""
@@ -499,15 +514,9 @@ def _run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, pro
                 try:
                     scene._step_count = k + 1
                     scene.check_finite()
-                except DivergenceError as e:
-                    bad = d.qfrc_applied[~np.isfinite(d.qfrc_applied)]
-                    if bad.size:                 # the drive's own output, not the timestep
-                        raise DivergenceError(
-                            f"the drive {drv.describe()} applied a non-finite moment ({bad[0]}) by t = "
-                            f"{(k + 1) * dt:.6g} s (step {k + 1}), voltage {v_steps[k]:.4g} V; the beam was finite "
-                            "until then: check the drive, not the timestep") from None
+                except DivergenceError:
                     who = f" Controller: {ctrl_name} (check its gains)." if controller is not None else ""
-                    raise DivergenceError(f"{e} Drive: {drv.describe()}, voltage {v_steps[k]:.4g} V.{who}") from None
+                    raise divergence_error(scene, drv, v_steps[k], k + 1, who) from None
             if k + 1 == nxt:
                 sample(k + 1)
                 i_sample += 1
