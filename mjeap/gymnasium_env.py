@@ -123,18 +123,18 @@ class CurvatureTrackingEnv(gymnasium.Env):
         self._step_limit = time_limit / self.control_timestep     # as dm_control's control.Environment
         self.metadata = {**type(self).metadata, "render_fps": 1.0 / self.control_timestep}
         self._limiter = VoltageLimiter()
-        self.episode, self._steps, self._last_obs = {}, 0, None
+        self.episode, self._steps = {}, 0
         self.scene.reset()
         self.drive.reset(0.0)
         self.voltage = self.drive.rest_voltage()
         self._signal_names = list(self.drive.signals())
+        self._last_obs = self._observe()          # at rest; reset() draws an episode
 
         # -- spaces -------------------------------------------------------------------------
         lo, hi = _float32_inside(*self.drive.voltage_range())
         self.action_space = spaces.Box(lo, hi, shape=(1,), dtype=np.float32)
-        shapes = {k: np.shape(v) for k, v in self._observe().items()}
         self.observation_space = spaces.Dict(
-            {k: spaces.Box(-np.inf, np.inf, shape=s, dtype=np.float64) for k, s in shapes.items()})
+            {k: spaces.Box(-np.inf, np.inf, shape=v.shape, dtype=np.float64) for k, v in self._last_obs.items()})
 
         # -- rendering ----------------------------------------------------------------------
         self.render_mode, self._renderer = render_mode, None
