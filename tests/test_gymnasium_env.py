@@ -37,9 +37,9 @@ def test_gymnasium_check_env_passes(gl, kw):
     """gymnasium's env_checker on the registered env (an ionic and a piezo drive); its only
     warnings are its advice on the spaces (infinite observation bounds, an action in volts
     rather than [-1, 1])."""
-    env = gymnasium.make(ENV_ID, **kw)
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
+        env = gymnasium.make(ENV_ID, **kw)
         check_env(env.unwrapped, skip_render_check=not gl)
     advice = ("infinity", "symmetric and normalized")
     assert [str(w.message) for w in caught if not any(a in str(w.message) for a in advice)] == []
