@@ -82,7 +82,7 @@ class CurvatureTrackingTask(base.Task):
         self.initial_curvature_range = check_curvature_range(initial_curvature_range, None)   # bounds: per beam
         self.reward_margin = check_positive("reward_margin", reward_margin, "1/m")
         self.reward_fn = reward_fn
-        self.limiter = VoltageLimiter()
+        self.limiter = VoltageLimiter("the action_spec")
         self.episode = {}
 
     @property

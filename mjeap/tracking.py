@@ -91,11 +91,12 @@ def draw_episode(scene, random, payload_mass_range: Optional[Tuple[float, float]
 
 class VoltageLimiter:
     """An action as the drive's input: one finite voltage (V; a number or an array of shape
-    (1,), more values are refused, not cut), clipped to the drive's safe range. Clipped
-    actions are counted in ``saturated_steps`` and warned about once per episode
-    (:meth:`reset` starts one)."""
+    (1,), more values are refused, not cut, naming ``space``), clipped to the drive's safe
+    range. Clipped actions are counted in ``saturated_steps`` and warned about once per
+    episode (:meth:`reset` starts one)."""
 
-    def __init__(self):
+    def __init__(self, space: str = "the action space"):
+        self.space = space
         self.reset()
 
     def reset(self) -> None:
@@ -103,7 +104,7 @@ class VoltageLimiter:
 
     def __call__(self, action, drive, stacklevel: int = 3) -> float:
         actuator = drive.scene.actuator.id
-        u = one_voltage(action, "action", f"the action space: shape (1,), the voltage of {actuator}")
+        u = one_voltage(action, "action", f"{self.space}: shape (1,), the voltage of {actuator}")
         lo, hi = drive.voltage_range()
         v = min(max(u, lo), hi)
         if v != u:
