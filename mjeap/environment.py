@@ -15,44 +15,26 @@ mass range below the actuator's stability limit (``mjeap validate`` reports it).
 from __future__ import annotations
 
 import argparse
-import collections
-import warnings
 from typing import Callable, Optional, Tuple
 
-import mujoco
 import numpy as np
 from dm_control.mujoco import engine, wrapper
 from dm_control.rl import control
 from dm_control.suite import base
-from dm_control.utils import rewards
 from dm_env import specs
 
 from . import install_mujoco_warnings
 from .cli import arg_integer, arg_number, arg_output, parse_args
 from .discretize import Payload
 from .drives import make_drive
-from .errors import MjeapError, ParameterError, check_positive, check_range
+from .errors import MjeapError, check_positive, check_range
 from .outputs import guarded, provenance
-from .engines.frame import check_initial_curvature, one_voltage
-from .engines.loop import advance
 from .scene import Scene
+from .tracking import (check_curvature_range, check_mass_range, default_reference, draw_episode, observe,
+                       step_lockstep, tracking_reward, VoltageLimiter)
 from .versions import dm_control_problem
 
 install_mujoco_warnings()         # dm_control's import installed its own MuJoCo warning handler
-
-
-def check_curvature_range(bounds, length: Optional[float]) -> Tuple[float, float]:
-    """``(low, high)`` initial curvatures (1/m) with low <= high, each within rollout's
-    bounds for a beam of ``length`` m (finite, at most a full circle; None: order only)."""
-    try:
-        lo, hi = (float(x) for x in bounds)
-    except (TypeError, ValueError):
-        raise ParameterError("initial_curvature_range", bounds, "(low, high) 1/m") from None
-    for k in (lo, hi) if length is not None else ():
-        check_initial_curvature(k, length, "initial_curvature_range")
-    if lo > hi:
-        raise ParameterError("initial_curvature_range", bounds, "(low, high) 1/m with low <= high")
-    return lo, hi
 
 
 class BeamPhysics(engine.Physics):
@@ -75,9 +57,8 @@ class BeamPhysics(engine.Physics):
         return self.scene.time
 
     def step(self, nstep: int = 1) -> None:
-        with self.check_invalid_state():       # the loop engine's lockstep: drive, then MuJoCo
-            advance(self.model.ptr, self.data.ptr, self.drive, self.voltage, self.scene.timestep, nstep)
-        self.scene._step_count += nstep
+        with self.check_invalid_state():
+            step_lockstep(self.scene, self.drive, self.voltage, nstep)     # on the physics' model and data
         self.scene.check_finite()
         self.scene.update_kinematics()
 
@@ -99,42 +80,30 @@ class CurvatureTrackingTask(base.Task):
                  reward_fn: Optional[Callable[[float, float], float]] = None, random=None):
         super().__init__(random=random)
         self.reference = reference
-        if payload_mass_range is not None:
-            lo, hi = (float(x) for x in payload_mass_range)
-            if not (0 < lo <= hi):
-                raise ParameterError("payload_mass_range", payload_mass_range, "(low, high) kg with 0 < low <= high")
-        self.payload_mass_range = payload_mass_range
+        self.payload_mass_range = check_mass_range(payload_mass_range)
         self.initial_curvature_range = check_curvature_range(initial_curvature_range, None)   # bounds: per beam
         self.reward_margin = check_positive("reward_margin", reward_margin, "1/m")
         self.reward_fn = reward_fn
-        self.saturated_steps = 0
+        self.limiter = VoltageLimiter("the action_spec")
         self.episode = {}
+
+    @property
+    def saturated_steps(self) -> int:
+        """Actions clipped to the safe range in this episode."""
+        return self.limiter.saturated_steps
 
     # -- episode -----------------------------------------------------------------------
     def initialize_episode(self, physics: BeamPhysics) -> None:
-        sc, m = physics.scene, physics.model.ptr
-        self.episode = {}
-        if self.payload_mass_range is not None:
-            if sc.payload_id < 0:
-                raise ParameterError("payload_mass_range", self.payload_mass_range,
-                                     "None for a scene without a payload (give the scene a nominal payload)")
-            mass = float(self.random.uniform(*self.payload_mass_range))
-            u = sc.units
-            m.body_mass[sc.payload_id] = mass / u.mass
-            p = sc.payload   # same sphere (or the same given inertia) with the new mass
-            m.body_inertia[sc.payload_id] = (p.rotary_inertia if p.rotary_inertia is not None else
-                                             Payload(mass, p.position, p.sphere_radius).inertia) / u.inertia
-            mujoco.mj_setConst(m, physics.data.ptr)
-            self.episode["payload_mass_kg"] = mass
+        sc = physics.scene
         check_curvature_range(self.initial_curvature_range, sc.layout.length)
-        kappa0 = float(self.random.uniform(*self.initial_curvature_range))
-        self.episode["initial_curvature_per_m"] = kappa0
+        self.episode = draw_episode(sc, self.random, self.payload_mass_range, self.initial_curvature_range)
+        kappa0 = self.episode["initial_curvature_per_m"]
         if kappa0:
             sc.set_hinge_angles(np.full(sc.layout.segments, kappa0 * sc.layout.ds))
         sc._step_count = 0
         physics.drive.reset(kappa0)
         physics.voltage = physics.drive.rest_voltage()
-        self.saturated_steps, self._warned = 0, False
+        self.limiter.reset()
         self._signal_names = list(physics.drive.signals())
 
     def action_spec(self, physics: BeamPhysics):
@@ -142,31 +111,13 @@ class CurvatureTrackingTask(base.Task):
         return specs.BoundedArray((1,), np.float64, lo, hi, name="voltage (V)")
 
     def before_step(self, action, physics: BeamPhysics) -> None:
-        u = one_voltage(action, "action", f"the action_spec: shape (1,), the voltage of {physics.scene.actuator.id}")
-        if not np.isfinite(u):
-            raise ParameterError("action", u, "a finite voltage in V")
-        lo, hi = physics.drive.voltage_range()
-        v = min(max(u, lo), hi)
-        if v != u:
-            self.saturated_steps += 1
-            if not self._warned:
-                warnings.warn(f"action {u:.4g} V clipped to the safe range [{lo:g}, {hi:g}] V of "
-                              f"{physics.scene.actuator.id}", stacklevel=2)
-                self._warned = True
-        physics.voltage = v
+        physics.voltage = self.limiter(action, physics.drive)
 
     # -- read-outs ---------------------------------------------------------------------
     def get_observation(self, physics: BeamPhysics):
-        sc = physics.scene
-        sig = physics.drive.signals()
-        obs = collections.OrderedDict()
-        obs["tip_curvature"] = np.array([sc.tip_curvature()])                 # 1/m
-        obs["reference"] = np.array([float(self.reference(sc.time))])          # 1/m
-        obs["tip_position"] = sc.tip_position()                               # m, clamp frame
-        obs["drive_state"] = np.array([sig[k] for k in self._signal_names])  # SI, see drive_state_names
-        if "current (A)" in sig:
-            obs["current"] = np.array([sig["current (A)"]])                   # A
-        return obs
+        """tip_curvature (1/m), reference (1/m), tip_position (m, clamp frame), drive_state
+        (SI, see drive_state_names) and current (A) where the drive reports one."""
+        return observe(physics.scene, physics.drive, self.reference, self._signal_names)
 
     @property
     def drive_state_names(self):
@@ -177,7 +128,7 @@ class CurvatureTrackingTask(base.Task):
         k, ref = sc.tip_curvature(), float(self.reference(sc.time))
         if self.reward_fn is not None:
             return float(self.reward_fn(k, ref))
-        return float(rewards.tolerance(k - ref, bounds=(0.0, 0.0), margin=self.reward_margin, sigmoid="gaussian"))
+        return tracking_reward(k, ref, self.reward_margin)
 
 
 def check_dm_control() -> None:
@@ -197,9 +148,7 @@ def make_environment(actuator: str = "pedot-micro", reference: Optional[Callable
     0.05 Hz sine of 50 1/m, seed 000's closed-loop case) with ``actuator``. The agent acts
     every ``control_interval`` s (rounded to whole MuJoCo steps) for ``time_limit`` s."""
     check_dm_control()
-    if reference is None:
-        def reference(t):
-            return 50.0 * np.sin(2 * np.pi * 0.05 * t)
+    reference = default_reference if reference is None else reference
     scene = Scene(actuator, orientation=orientation, payload=payload, segments=segments)
     check_curvature_range(initial_curvature_range, scene.layout.length)
     drv = make_drive(drive, scene, **(drive_params or {}))

@@ -34,6 +34,21 @@ def advance(model, data, drive, voltage: float, dt: float, nstep: int = 1) -> No
         mujoco.mj_step(model, data)
 
 
+def divergence_error(scene, drv, voltage: float, step: int, who: str = "") -> DivergenceError:
+    """The error of a lockstep run of ``scene`` and ``drv`` that blew up by ``step`` (the
+    last with ``voltage`` V held): a drive whose own moment is not finite is named as the
+    cause, else the scene's error (timestep against its stability limit) with the drive and
+    voltage, and ``who`` (a controller) added."""
+    d = scene.data
+    bad = d.qfrc_applied[~np.isfinite(d.qfrc_applied)]
+    if bad.size:                 # the drive's own output, not the timestep
+        return DivergenceError(
+            f"the drive {drv.describe()} applied a non-finite moment ({bad[0]}) by t = "
+            f"{step * scene.timestep:.6g} s (step {step}), voltage {voltage:.4g} V; the beam was finite "
+            "until then: check the drive, not the timestep")
+    return DivergenceError(f"{scene.divergence_error()} Drive: {drv.describe()}, voltage {voltage:.4g} V.{who}")
+
+
 class LoopEngine(Engine):
     """Every drive, open or closed loop, one run at a time."""
 
@@ -87,15 +102,9 @@ def run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, prog
         try:
             scene._step_count = done
             scene.check_finite()
-        except DivergenceError as e:
-            bad = d.qfrc_applied[~np.isfinite(d.qfrc_applied)]
-            if bad.size:                 # the drive's own output, not the timestep
-                raise DivergenceError(
-                    f"the drive {drv.describe()} applied a non-finite moment ({bad[0]}) by t = "
-                    f"{done * dt:.6g} s (step {done}), voltage {v_steps[k]:.4g} V; the beam was finite "
-                    "until then: check the drive, not the timestep") from None
+        except DivergenceError:
             who = f" Controller: {ctrl_name} (check its gains)." if controller is not None else ""
-            raise DivergenceError(f"{e} Drive: {drv.describe()}, voltage {v_steps[k]:.4g} V.{who}") from None
+            raise divergence_error(scene, drv, v_steps[k], done, who) from None
 
     try:
         lockstep(m, d, n_steps, sample_steps, before, sample, check, check_every,
