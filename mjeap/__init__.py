@@ -28,7 +28,8 @@ from .catalog import CATALOG, Actuator, Layer, Planform, get_actuator, actuator_
 from .discretize import BeamLayout, Payload, discretize, parse_quantity  # noqa: E402
 from .errors import DivergenceError, MjeapError, ParameterError, UnknownNameError  # noqa: E402
 from .mjcf import REPRESENTATIONS, build_spec  # noqa: E402
-from .scene import Scene, load_mjcf  # noqa: E402
+from .scene import Scene  # noqa: E402
+from .fields import load_mjcf  # noqa: E402
 from .units import DEFAULT_UNITS, UnitSystem  # noqa: E402
 from . import analytical  # noqa: E402
 from .drives import DRIVES, Drive, register_drive  # noqa: E402

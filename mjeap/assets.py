@@ -6,7 +6,8 @@ import textwrap
 from pathlib import Path
 from typing import Dict, Iterator, Tuple
 
-from . import native
+from .engines.native import why_not
+from .fields import add_units
 from .catalog import CATALOG
 from .drives import make_drive
 from .mjcf import REPRESENTATIONS
@@ -25,7 +26,7 @@ def asset_xml(actuator_id: str, representation: str) -> str:
     passive beam; the internal units in the custom numeric ``mjeap_units``."""
     s = Scene(actuator_id, representation=representation)
     drv = make_drive(None, s)
-    why = native.why_not(s, drv)
+    why = why_not(s, drv)
     if why is None:
         spec = s.native_model(drv).spec
         lo, hi = drv.voltage_range()
@@ -38,7 +39,7 @@ def asset_xml(actuator_id: str, representation: str) -> str:
                       f"--mjcf=assets/mjcf/{asset_name(actuator_id, representation)}")
     else:
         spec = s.spec.copy()
-        native.add_units(spec, s.units)
+        add_units(spec, s.units)
         drive_note = f"Passive beam: {why}. Drive it with mjeap (loop or threaded engine)."
     add_viewing(spec, s)
     drive_note = "\n".join(textwrap.wrap(drive_note, 95, initial_indent=" " * 5, subsequent_indent=" " * 5)) + "\n"

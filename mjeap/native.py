@@ -28,10 +28,7 @@ from typing import Dict, List, Optional
 import mujoco
 import numpy as np
 
-from .errors import ParameterError
-from .units import UnitSystem
 
-UNITS_FIELD = "mjeap_units"
 ACTUATOR = "drive"
 TENDON = "bend"
 #: armature of a relaxation dof as a fraction of (timestep x its damping): the arm's inertial
@@ -50,43 +47,6 @@ class NativeHandles:
     tendon: str = TENDON
     relaxation_joints: List[str] = field(default_factory=list)
     sensors: Dict[str, str] = field(default_factory=dict)
-
-
-def add_units(spec: mujoco.MjSpec, units: UnitSystem) -> None:
-    """Declare the internal units in the file: custom numeric ``mjeap_units`` = L M T (SI)."""
-    for n in spec.numerics:
-        if n.name == UNITS_FIELD:
-            n.data = [units.length, units.mass, units.time]
-            return
-    spec.add_numeric(name=UNITS_FIELD, data=[units.length, units.mass, units.time])
-
-
-def read_numeric(model: mujoco.MjModel, name: str, size: int, accepted: str,
-                 positive: bool = False) -> Optional[np.ndarray]:
-    """The values of the custom numeric ``name`` (None if the model has none), refused
-    unless there are exactly ``size`` of them, finite and >= 0 (> 0 if ``positive``):
-    MuJoCo keeps every numeric in one array, so a short field read at its length would
-    run into the next one. ``accepted`` says what they are, for the message."""
-    i = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_NUMERIC, name)
-    if i < 0:
-        return None
-    a, n = int(model.numeric_adr[i]), int(model.numeric_size[i])
-    v = np.array(model.numeric_data[a:a + n], dtype=float)
-    if n != size:
-        raise ParameterError(name, f"{n} values", f"{size} values: {accepted}")
-    bad = ~np.isfinite(v) | ((v <= 0) if positive else (v < 0))
-    if bad.any():
-        j = int(np.argmax(bad))
-        raise ParameterError(name, f"{float(v[j])!r} at index {j}",
-                             f"finite values {'> 0' if positive else '>= 0'}: {accepted}")
-    return v
-
-
-def read_units(model: mujoco.MjModel) -> Optional[UnitSystem]:
-    """The unit system a model declares in ``mjeap_units`` (None if it declares none)."""
-    v = read_numeric(model, UNITS_FIELD, 3, "L M T, the SI size of one internal length (m), mass (kg) "
-                     "and time (s) unit", positive=True)
-    return None if v is None else UnitSystem(*map(float, v))
 
 
 def add_bending_tendon(spec: mujoco.MjSpec, joints, coefficients, name: str = TENDON):
@@ -139,70 +99,3 @@ def add_maxwell_arms(spec: mujoco.MjSpec, joints, parent: str, k, zero: float, p
         t.wrap_joint(f"relax{j}", -1.0)
         names.append(f"relax{j}")
     return names
-
-
-def why_not(scene, drive, controller=None) -> Optional[str]:
-    """None where the native engine applies to this run of ``scene``; else why not."""
-    if controller is not None:
-        return "a controller closes the loop (its voltage depends on the state)"
-    if scene.representation != "hinge":
-        return (f"the {scene.representation} representation's ball joints cannot be summed by a fixed tendon "
-                "(the native drives act on the hinge chain)")
-    reason = drive.native_reason()
-    if reason is not None:
-        return f"the {drive.name} drive has no native form: {reason}"
-    return None
-
-
-class NativeModel:
-    """A scene's beam with its drive compiled in (internal units, the scene's timestep,
-    damping and present hinge parameters): ``model``, ``data``, the actuator's ``part``
-    (the scene's names, so the same read-outs) and the drive's ``handles``."""
-
-    def __init__(self, scene, drive, check_stability: bool = True):
-        from .component import ActuatorPart
-        from .errors import ParameterError
-        from .scene import apply_dof_damping
-        why = why_not(scene, drive)
-        if why is not None:
-            raise ParameterError("engine", "native", f"'loop' or 'auto' for this run: {why}")
-        spec = scene.spec.copy()
-        m0 = scene.model
-        for name, j in zip(scene.handles.joints, scene.part.joint_ids):   # present values (identify may set them)
-            spec.joint(name).stiffness = [float(m0.jnt_stiffness[j]), 0.0, 0.0]
-            spec.joint(name).damping = [float(m0.dof_damping[m0.jnt_dofadr[j]]), 0.0, 0.0]
-        self.handles = drive.add_native(spec, scene.handles.joints, scene.handles.clamp_body)
-        add_units(spec, scene.units)
-        self.spec, self.drive, self.scene = spec, drive, scene
-        self.model = apply_dof_damping(spec.compile())
-        if check_stability:
-            self.check_stability()
-        self.data = mujoco.MjData(self.model)
-        self.part = ActuatorPart(self.model, scene.handles, scene.layout, scene.actuator, scene.units,
-                                 scene.representation, scene.payload, rotation=scene.rotation)
-        self.part.bind(self.data)
-        self.actuator_id = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_ACTUATOR, self.handles.actuator)
-
-    def check_stability(self) -> None:
-        """The scene chose its timestep for the bare beam; the drive's elements (Maxwell arms)
-        must not make the linearised step map unstable at that timestep."""
-        from .errors import ParameterError
-        from .modes import linearize, spectral_radius
-        lin = linearize(self.model)
-        rho = spectral_radius(lin, self.model.dof_damping, self.model.opt.timestep, self.scene.integrator)
-        if rho > 1.0 + 1e-9:
-            raise ParameterError("timestep", self.scene.timestep, "a timestep at which the native drive is stable",
-                                 f"spectral radius {rho:.6g} of the native model's step map")
-
-    def reset(self, initial_curvature: float = 0.0) -> None:
-        """Rest at a uniform arc of ``initial_curvature`` (1/m), the drive state at rest there;
-        the scene's tip loads act here too."""
-        mujoco.mj_resetData(self.model, self.data)
-        src = self.scene.part
-        self.part._tip_force_world, self.part._tip_moment = src._tip_force_world.copy(), src._tip_moment
-        self.part.apply_loads()
-        lay = self.scene.layout
-        if initial_curvature:
-            self.part.set_hinge_angles(np.full(lay.segments, initial_curvature * lay.ds), forward=False)
-        mujoco.mj_forward(self.model, self.data)
-        self.drive.native_reset(self.part, self.handles)

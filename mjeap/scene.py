@@ -39,13 +39,12 @@ from __future__ import annotations
 import math
 import warnings
 from dataclasses import dataclass
-from typing import Optional, Sequence, Union
+from typing import Optional, Union
 
 import mujoco
 import numpy as np
 import scipy.linalg
 
-from . import analytical
 from .accuracy import check_accuracy
 from .catalog import Actuator, get_actuator
 from .component import ActuatorPart, write_hinge_angles
@@ -53,7 +52,7 @@ from .discretize import BeamLayout, Payload, check_payload, clamp_rotation, disc
 from .errors import DivergenceError, ParameterError, check_positive, check_range
 from .mjcf import build_spec, get_builder
 from .modes import linearize, modal_frequencies, stability_limit
-from .native import read_numeric
+from .fields import DOF_DAMPING_FIELD, apply_dof_damping
 from .units import DEFAULT_UNITS, UnitSystem
 
 STEPS_PER_PERIOD = 50
@@ -72,7 +71,6 @@ HEAVY_PAYLOAD = 1e5
 #: tip angle (rad) of the uniform arc at which the cable's stability limit is checked
 #: besides the straight beam; seed 000's actuator bends to about 1.8 rad
 DEFAULT_MAX_BEND = 2.0
-DOF_DAMPING_FIELD = "mjeap_dof_damping"
 
 
 def diverged(data: mujoco.MjData) -> bool:
@@ -85,34 +83,6 @@ def diverged(data: mujoco.MjData) -> bool:
 def _floor_sig(x: float, digits: int) -> float:
     e = np.floor(np.log10(x)) - (digits - 1)
     return float(np.floor(x / 10**e * (1 + 1e-12)) * 10**e)
-
-
-def apply_dof_damping(model: mujoco.MjModel) -> mujoco.MjModel:
-    """Apply the per-dof Rayleigh damping stored in a generated model (cable), in place:
-    ``mjeap_dof_damping`` holds one value per dof of the model, ``PREFIX/mjeap_dof_damping``
-    (a beam attached under ``PREFIX/``, :mod:`mjeap.system`) one per dof of the joints
-    named ``PREFIX/...``, in dof order. Values that are not finite and >= 0, or not one per
-    dof, are refused with the field named."""
-    for i in range(model.nnumeric):
-        name = mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_NUMERIC, i) or ""
-        prefix = name[:-len(DOF_DAMPING_FIELD)]
-        if not name.endswith(DOF_DAMPING_FIELD) or not (prefix == "" or prefix.endswith("/")):
-            continue
-        if prefix:
-            joints = [j for j in range(model.njnt)
-                      if (mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_JOINT, j) or "").startswith(prefix)]
-            dofs = np.flatnonzero(np.isin(model.dof_jntid, joints))
-        else:
-            dofs = np.arange(model.nv)
-        model.dof_damping[dofs] = read_numeric(
-            model, name, len(dofs), f"one damping per dof of {'the model' if not prefix else repr(prefix)} "
-            "(internal units)")
-    return model
-
-
-def load_mjcf(path: str) -> mujoco.MjModel:
-    """Load a model written by mjeap (``assets/mjcf``) with its per-dof damping applied."""
-    return apply_dof_damping(mujoco.MjModel.from_xml_path(str(path)))
 
 
 @dataclass(frozen=True)
@@ -457,7 +427,7 @@ class Scene:
         """This beam with ``drive`` (a :class:`mjeap.Drive` of this scene) compiled into the
         model as MuJoCo elements (:mod:`mjeap.native`); built once per drive, parameters
         and hinge parameters (a compile and a stability check, ~10 ms), then reused."""
-        from .native import NativeModel
+        from .native_model import NativeModel
         key = (drive.name, repr(sorted(drive.params.items())), self.part.revision)
         cache = self.__dict__.setdefault("_native_models", {})
         if key not in cache:

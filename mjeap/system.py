@@ -28,13 +28,15 @@ from typing import Dict, List, Optional, Sequence, Union
 import mujoco
 import numpy as np
 
-from . import native
+from .native import NativeHandles
 from .component import ActuatorPart
 from .errors import DivergenceError, ParameterError, UnknownNameError, check_positive
 from .outputs import guarded, provenance
 from .versions import newton_sparse_broken
 from .engines.frame import one_voltage
-from .scene import DEFAULT_SEGMENTS, INTEGRATORS, Scene, apply_dof_damping, diverged
+from .engines.native import why_not as native_why_not
+from .fields import UNITS_FIELD, add_units, apply_dof_damping
+from .scene import DEFAULT_SEGMENTS, INTEGRATORS, Scene, diverged
 from .units import DEFAULT_UNITS, UnitSystem
 
 _PREFIX = re.compile(r"^[A-Za-z][A-Za-z0-9_-]*$")
@@ -106,7 +108,7 @@ class AttachedActuator:
     prefix: str                      # with its trailing '/'
     twin: Scene                      # the equivalent one-actuator Scene (layout, damping, timestep)
     drive: Optional[object]          # the drive (its native form is in the model), None if passive
-    native: Optional[native.NativeHandles]
+    native: Optional[NativeHandles]
     contact: bool
 
     def name(self, element: str) -> str:
@@ -261,13 +263,13 @@ def attach(spec: mujoco.MjSpec, actuator, *, prefix: str, site: Optional[str] = 
     else:
         from .drives import make_drive
         drv = make_drive(drive, twin, **(drive_params or {}))
-        why = native.why_not(twin, drv)
+        why = native_why_not(twin, drv)
         if why is not None:
             raise ParameterError("drive", drv.name, "a drive with a native form, or passive=True", why)
         nm = twin.native_model(drv)
         child, nat = nm.spec.copy(), nm.handles
     for n in list(child.numerics):
-        if n.name == native.UNITS_FIELD:
+        if n.name == UNITS_FIELD:
             child.delete(n)
     if contact:
         for b in twin.handles.link_bodies:              # the hinge chain's links, the cable's segments
@@ -408,7 +410,7 @@ class System:
             t_min = min(a.twin.layout.thickness for a in self.actuators if a.contact) / units.length
             contact.apply(spec, h / units.time, t_min, units.length)
         self.contact = contact
-        native.add_units(spec, units)
+        add_units(spec, units)
         try:
             model = spec.compile()
         except ValueError as e:

@@ -24,7 +24,7 @@ ROOT = Path(__file__).resolve().parent.parent
 
 #: the modules behind the scripts' command lines (the scripts themselves are thin)
 SCRIPT_MODULES = {"hamr_leg": "mjeap.robots.hamr_leg", "robobee_wing": "mjeap.robots.robobee_wing",
-                  "gripper": "mjeap.robots.gripper", "stability_map": "mjeap.stability",
+                  "gripper": "mjeap.robots.gripper", "stability_map": "mjeap.stability_map",
                   "env_episode": "mjeap.environment"}
 
 

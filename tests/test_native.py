@@ -17,7 +17,7 @@ from mjeap import Scene, rollout, rollout_batch
 from mjeap.assets import ASSET_DIR
 from mjeap.drives import make_drive
 from mjeap.errors import ParameterError
-from mjeap.native import read_units
+from mjeap.fields import read_units
 from mjeap.validation import golden
 
 CASES = [  # actuator, scene kwargs, waveform, duration s, initial curvature 1/m, tolerance (of the swing)

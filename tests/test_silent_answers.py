@@ -10,7 +10,7 @@ import pytest
 
 from mjeap import Scene, load_mjcf, rollout, rollout_batch
 from mjeap.errors import MjeapError, ParameterError
-from mjeap.native import read_units
+from mjeap.fields import read_units
 from mjeap.system import System, attach
 
 G = "0 0 -0.00980665"      # standard gravity in mm / ms^2

@@ -43,10 +43,10 @@ def test_attached_at_a_tilted_site_moves_as_its_scene(contact, integrator):
 
 
 def _native_actuators():
-    from mjeap import native
+    from mjeap.engines.native import why_not
     from mjeap.catalog import actuator_ids
     from mjeap.drives import make_drive
-    return [a for a in actuator_ids() if native.why_not(Scene(a), make_drive(None, Scene(a))) is None]
+    return [a for a in actuator_ids() if why_not(Scene(a), make_drive(None, Scene(a))) is None]
 
 
 @pytest.mark.parametrize("actuator", _native_actuators())

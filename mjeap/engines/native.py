@@ -1,4 +1,4 @@
-"""The ``native`` engine: the drive compiled into the model (:class:`mjeap.native.NativeModel`),
+"""The ``native`` engine: the drive compiled into the model (:class:`mjeap.native_model.NativeModel`),
 the voltages its actuator's ctrl, stepped by ``mujoco.rollout`` (no Python per step; many
 rollouts over a thread pool)."""
 from __future__ import annotations
@@ -8,19 +8,31 @@ from typing import Optional, Sequence
 import mujoco
 import numpy as np
 
-from .. import native as compiled
 from ..drives.base import Drive
 from . import Engine
 from .threaded import LOADS, NATIVE_CONTROL, STATE, raise_bad, roll
 
 
+def why_not(scene, drive, controller=None) -> Optional[str]:
+    """None where the native engine applies to this run of ``scene``; else why not."""
+    if controller is not None:
+        return "a controller closes the loop (its voltage depends on the state)"
+    if scene.representation != "hinge":
+        return (f"the {scene.representation} representation's ball joints cannot be summed by a fixed tendon "
+                "(the native drives act on the hinge chain)")
+    reason = drive.native_reason()
+    if reason is not None:
+        return f"the {drive.name} drive has no native form: {reason}"
+    return None
+
+
 class NativeEngine(Engine):
-    """Drives with a native form, open loop (:func:`mjeap.native.why_not`)."""
+    """Drives with a native form, open loop (:func:`why_not`)."""
 
     name, batched = "native", True
 
     def why_not(self, scene, drive, controller=None) -> Optional[str]:
-        return compiled.why_not(scene, drive, controller)
+        return why_not(scene, drive, controller)
 
     def part(self, scene, drive):
         return scene.native_model(drive).part
@@ -33,7 +45,7 @@ class NativeEngine(Engine):
 
 def run_native(scene, native, drives: Sequence, v_steps: Sequence[np.ndarray], initial_curvatures: Sequence[float],
                sample_steps: np.ndarray, samples: Sequence, nthread: int = 0) -> None:
-    """As :func:`run`, on the scene's native model (:class:`mjeap.native.NativeModel`): the
+    """As :func:`run`, on the scene's native model (:class:`mjeap.native_model.NativeModel`): the
     controls are the voltages themselves (the actuator's ctrl), the drive runs inside
     MuJoCo. The scene is left in the final state of the last run (its beam dofs)."""
     m, d, part, h = native.model, native.data, native.part, native.handles

@@ -1,0 +1,63 @@
+"""A scene's beam with its drive compiled in (:class:`NativeModel`), the model the native
+engine (:mod:`mjeap.engines.native`) steps."""
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+from .component import ActuatorPart
+from .engines.native import why_not
+from .errors import ParameterError
+from .fields import add_units, apply_dof_damping
+from .modes import linearize, spectral_radius
+
+__all__ = ["NativeModel"]
+
+
+class NativeModel:
+    """A scene's beam with its drive compiled in (internal units, the scene's timestep,
+    damping and present hinge parameters): ``model``, ``data``, the actuator's ``part``
+    (the scene's names, so the same read-outs) and the drive's ``handles``."""
+
+    def __init__(self, scene, drive, check_stability: bool = True):
+        why = why_not(scene, drive)
+        if why is not None:
+            raise ParameterError("engine", "native", f"'loop' or 'auto' for this run: {why}")
+        spec = scene.spec.copy()
+        m0 = scene.model
+        for name, j in zip(scene.handles.joints, scene.part.joint_ids):   # present values (identify may set them)
+            spec.joint(name).stiffness = [float(m0.jnt_stiffness[j]), 0.0, 0.0]
+            spec.joint(name).damping = [float(m0.dof_damping[m0.jnt_dofadr[j]]), 0.0, 0.0]
+        self.handles = drive.add_native(spec, scene.handles.joints, scene.handles.clamp_body)
+        add_units(spec, scene.units)
+        self.spec, self.drive, self.scene = spec, drive, scene
+        self.model = apply_dof_damping(spec.compile())
+        if check_stability:
+            self.check_stability()
+        self.data = mujoco.MjData(self.model)
+        self.part = ActuatorPart(self.model, scene.handles, scene.layout, scene.actuator, scene.units,
+                                 scene.representation, scene.payload, rotation=scene.rotation)
+        self.part.bind(self.data)
+        self.actuator_id = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_ACTUATOR, self.handles.actuator)
+
+    def check_stability(self) -> None:
+        """The scene chose its timestep for the bare beam; the drive's elements (Maxwell arms)
+        must not make the linearised step map unstable at that timestep."""
+        lin = linearize(self.model)
+        rho = spectral_radius(lin, self.model.dof_damping, self.model.opt.timestep, self.scene.integrator)
+        if rho > 1.0 + 1e-9:
+            raise ParameterError("timestep", self.scene.timestep, "a timestep at which the native drive is stable",
+                                 f"spectral radius {rho:.6g} of the native model's step map")
+
+    def reset(self, initial_curvature: float = 0.0) -> None:
+        """Rest at a uniform arc of ``initial_curvature`` (1/m), the drive state at rest there;
+        the scene's tip loads act here too."""
+        mujoco.mj_resetData(self.model, self.data)
+        src = self.scene.part
+        self.part._tip_force_world, self.part._tip_moment = src._tip_force_world.copy(), src._tip_moment
+        self.part.apply_loads()
+        lay = self.scene.layout
+        if initial_curvature:
+            self.part.set_hinge_angles(np.full(lay.segments, initial_curvature * lay.ds), forward=False)
+        mujoco.mj_forward(self.model, self.data)
+        self.drive.native_reset(self.part, self.handles)
