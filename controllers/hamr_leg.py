@@ -28,12 +28,12 @@ import numpy as np
 from scipy import optimize
 
 from mjeap import Scene, rollout
-from mjeap.catalog import get_actuator
-from mjeap.discretize import Payload
+from mjeap.model.catalog import get_actuator
+from mjeap.model.discretize import Payload
 from mjeap.errors import ParameterError, check_positive
-from mjeap.frequency import phasor
+from mjeap.analysis.frequency import phasor
 
-from .self_sensing import SelfSensingEstimator, calibrate_on_free_actuator
+from mjeap.controllers.self_sensing import SelfSensingEstimator, calibrate_on_free_actuator
 
 ACTUATOR = "pzt-hamr-small"
 MEASURED_RESONANCE = 1750.0     # Hz, Table 1, Type II
@@ -264,7 +264,7 @@ def write_leg_recording(path, run: LegRun, scene) -> None:
     circle-like loop for a 90 degree lag, the diagonal when in phase."""
     import rerun as rr
     import rerun.blueprint as rrb
-    from mjeap.recording import write_recording
+    from mjeap.io.recording import write_recording
 
     r, f = run.result, run.meta["frequency_hz"]
     tr = run.transmission

@@ -25,7 +25,7 @@ import numpy as np
 from scipy import optimize
 
 from mjeap.errors import ParameterError, check_positive
-from mjeap.frequency import SineSweep
+from mjeap.analysis.frequency import SineSweep
 
 
 @dataclass
@@ -121,7 +121,7 @@ def calibrate_on_free_actuator(actuator, bias: float, frequencies, **scene_kw) -
     the free actuator's :class:`mjeap.Scene`."""
     from mjeap import Scene
     from mjeap.drives import make_drive
-    from mjeap.frequency import sine_sweep
+    from mjeap.analysis.frequency import sine_sweep
     free = Scene(actuator, **scene_kw)
     p = make_drive("piezo-bimorph", free, bias=bias).params
     sweep = sine_sweep(free, tuple(frequencies), bias / 2, bias / 4, drive_params={"bias": bias})

@@ -7,11 +7,11 @@ from pathlib import Path
 from typing import Dict, Iterator, Tuple
 
 from .engines.native import why_not
-from .fields import add_units
-from .catalog import CATALOG
+from .model.fields import add_units
+from .model.catalog import CATALOG
 from .drives import make_drive
-from .mjcf import REPRESENTATIONS
-from .scene import Scene
+from .model.mjcf import REPRESENTATIONS
+from .simulation.scene import Scene
 
 ASSET_DIR = Path(__file__).resolve().parent.parent / "assets" / "mjcf"
 
@@ -22,7 +22,7 @@ def asset_name(actuator_id: str, representation: str) -> str:
 
 def asset_xml(actuator_id: str, representation: str) -> str:
     """MJCF text of one asset, with a header saying how it was made: the beam with its
-    drive compiled in where the drive has a native form (:mod:`mjeap.native`), else the
+    drive compiled in where the drive has a native form (:mod:`mjeap.drives.native`), else the
     passive beam; the internal units in the custom numeric ``mjeap_units``."""
     s = Scene(actuator_id, representation=representation)
     drv = make_drive(None, s)
@@ -89,7 +89,7 @@ def iter_assets() -> Iterator[Tuple[str, str]]:
 
 
 def write_assets(directory: Path = ASSET_DIR) -> Dict[str, Path]:
-    from .outputs import replacing
+    from .io.outputs import replacing
     directory.mkdir(parents=True, exist_ok=True)
     out = {}
     for aid, rep in iter_assets():

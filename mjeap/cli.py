@@ -17,7 +17,7 @@ def _fmt(v: float) -> str:
 
 
 def cmd_list(args) -> int:
-    from .catalog import CATALOG
+    from .model.catalog import CATALOG
     width = max(len(k) for k in CATALOG)
     for a in CATALOG.values():
         print(f"{a.id:<{width}}  {a.title}  [{a.document}]")
@@ -26,9 +26,9 @@ def cmd_list(args) -> int:
 
 def describe(name: str) -> dict:
     """Every parameter of a catalog actuator with unit and provenance, plus derived values."""
-    from . import analytical
-    from .catalog import get_actuator
-    from .scene import Scene
+    from .model import analytical
+    from .model.catalog import get_actuator
+    from .simulation.scene import Scene
     a = get_actuator(name)
     layers = []
     for l in a.layers:
@@ -102,8 +102,8 @@ def cmd_show(args) -> int:
 
 
 def _scene_from_args(args):
-    from .discretize import Payload
-    from .scene import Scene
+    from .model.discretize import Payload
+    from .simulation.scene import Scene
     payload = Payload.parse(args.payload) if args.payload else None
     return Scene(args.name, representation=args.representation, segments=args.segments,
                  orientation=args.orientation, payload=payload, timestep=args.timestep,
@@ -116,7 +116,7 @@ def cmd_mjcf(args) -> int:
     if args.output in (None, "-"):
         sys.stdout.write(xml)
     else:
-        from .outputs import replacing
+        from .io.outputs import replacing
         with replacing(args.output, "--output") as tmp:
             tmp.write_text(xml)
         c = scene.choice
@@ -139,8 +139,8 @@ def _params(pairs) -> dict:
 
 
 def cmd_rollout(args) -> int:
-    from .rollout import rollout
-    from .accuracy import check_accuracy
+    from .simulation.rollout import rollout
+    from .simulation.accuracy import check_accuracy
     if args.accuracy is not None:
         check_accuracy(args.accuracy)
         for flag, given in (("--timestep", args.timestep), ("--estimate-error", args.estimate_error or None)):
@@ -194,7 +194,7 @@ def cmd_validate(args) -> int:
 
 
 def cmd_identify_step(args) -> int:
-    from .identify import fit_step_response, read_columns
+    from .analysis.identify import fit_step_response, read_columns
     d = read_columns(args.file, [args.time_column, args.curvature_column])
     fit = fit_step_response(d[args.time_column], d[args.curvature_column], args.voltage, args.t_step)
     out = {"fit": "kappa(t) = A + B exp(-p t) + C exp(-a t)", "A_per_m": fit.A, "B_per_m": fit.B, "C_per_m": fit.C,
@@ -209,7 +209,7 @@ def cmd_identify_step(args) -> int:
 
 
 def cmd_identify_hinges(args) -> int:
-    from .identify import fit_hinge_parameters, read_columns
+    from .analysis.identify import fit_hinge_parameters, read_columns
     scene = _scene_from_args(args)
     d = read_columns(args.file, [args.time_column, args.tip_column])
     fit = fit_hinge_parameters(scene, d[args.time_column], d[args.tip_column], args.voltage, drive=args.drive,
@@ -222,9 +222,9 @@ def cmd_identify_hinges(args) -> int:
 
 
 def add_scene_args(p: argparse.ArgumentParser) -> None:
-    from .mjcf import REPRESENTATIONS
-    from .discretize import ORIENTATIONS
-    from .scene import DEFAULT_SEGMENTS, INTEGRATORS
+    from .model.mjcf import REPRESENTATIONS
+    from .model.discretize import ORIENTATIONS
+    from .simulation.scene import DEFAULT_SEGMENTS, INTEGRATORS
     p.add_argument("name", help="catalog id (see `mjeap list`)")
     p.add_argument("--segments", type=int, default=DEFAULT_SEGMENTS, help="number of segments (>= 2)")
     p.add_argument("--representation", choices=REPRESENTATIONS, default="hinge")
@@ -457,7 +457,7 @@ def arg_output(inside: Optional[str] = None):
     """argparse ``type=``: an output path that can be written (its folder made now), or,
     with ``inside``, a folder in which the file ``inside`` can be written
     (:func:`mjeap.rollout.check_outputs`). Returns the text."""
-    from .outputs import check_outputs
+    from .io.outputs import check_outputs
 
     def check(text: str) -> str:
         check_outputs(out=Path(text) / inside if inside else text)

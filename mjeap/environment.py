@@ -23,15 +23,14 @@ from dm_control.rl import control
 from dm_control.suite import base
 from dm_env import specs
 
-from . import install_mujoco_warnings
+from .errors import install_mujoco_warnings
 from .cli import arg_integer, arg_number, arg_output, parse_args
-from .discretize import Payload
+from .model.discretize import Payload
 from .drives import make_drive
 from .errors import MjeapError, check_positive, check_range
-from .outputs import guarded, provenance
-from .scene import Scene
-from .tracking import (check_curvature_range, check_mass_range, default_reference, draw_episode, observe,
-                       step_lockstep, tracking_reward, VoltageLimiter)
+from .io.outputs import guarded, provenance
+from .simulation.scene import Scene
+from .tracking import (check_curvature_range, check_mass_range, default_reference, draw_episode, observe, step_lockstep, tracking_reward, VoltageLimiter)
 from .versions import dm_control_problem
 
 install_mujoco_warnings()         # dm_control's import installed its own MuJoCo warning handler
@@ -166,10 +165,10 @@ def run_episode(env: control.Environment, policy: Callable, rrd=None):
     :class:`mjeap.RolloutResult` sampled at every agent step (the reward and the action as
     signals), written to ``rrd`` if given (also when the episode fails or is stopped, by
     Ctrl-C or SIGTERM; a second writer of it is refused, :func:`mjeap.outputs.guarded`)."""
-    from .analytical import arc_curvature
-    from .recording import write_recording
+    from .model.analytical import arc_curvature
+    from .io.recording import write_recording
     from .engines.frame import RolloutResult
-    from .outputs import write_outputs
+    from .io.outputs import write_outputs
 
     physics, task = env.physics, env.task
     sc = physics.scene

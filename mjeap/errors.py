@@ -123,3 +123,18 @@ class sigterm_as_interrupt:
         if self._old is not None:
             signal.signal(signal.SIGTERM, self._old)
         return False
+
+
+def _mujoco_warning(message: str) -> None:
+    """MuJoCo's warnings as Python warnings (not stderr and a MUJOCO_LOG.TXT in the working
+    directory); its times are in the model's internal units (ms by default)."""
+    import warnings
+    warnings.warn(f"MuJoCo: {message.strip()} (times in the model's internal units; mjeap's default unit is "
+                  "1 ms)", RuntimeWarning, stacklevel=2)
+
+
+def install_mujoco_warnings() -> None:
+    """Route MuJoCo's warnings through :func:`_mujoco_warning` (again after a library such
+    as dm_control installed its own handler)."""
+    import mujoco
+    mujoco.set_mju_user_warning(_mujoco_warning)

@@ -27,14 +27,13 @@ try:
 except ImportError as e:  # pragma: no cover - the optional extra
     raise ImportError("mjeap.gymnasium_env needs gymnasium 1.x: pip install 'mjeap[gym]'") from e
 
-from .catalog import get_actuator
-from .discretize import Payload
+from .model.catalog import get_actuator
+from .model.discretize import Payload
 from .drives import make_drive
 from .errors import MjeapError, ParameterError, check_integer, check_positive, check_range
 from .engines.loop import divergence_error
-from .scene import Scene, diverged
-from .tracking import (VoltageLimiter, check_curvature_range, check_mass_range, default_reference, draw_episode,
-                       observe, step_lockstep, tracking_reward)
+from .simulation.scene import Scene, diverged
+from .tracking import (VoltageLimiter, check_curvature_range, check_mass_range, default_reference, draw_episode, observe, step_lockstep, tracking_reward)
 
 __all__ = ["CurvatureTrackingEnv", "ENV_ID"]
 

@@ -1,6 +1,6 @@
 """The stability map of seed 000's inverted actuator as a command line: a sweep of payload
 mass x drive amplitude (:mod:`mjeap.sweep`), judged by seed 000's criterion, with the
-theory limits of :mod:`mjeap.stability` drawn over it; writes results.csv (resumable),
+theory limits of :mod:`mjeap.analysis.stability` drawn over it; writes results.csv (resumable),
 stability_map.png, report.md and stability_map.rrd (``python scripts/stability_map.py``)."""
 from __future__ import annotations
 
@@ -10,7 +10,7 @@ from pathlib import Path
 import numpy as np
 
 from .cli import arg_integer, arg_output, parse_args
-from .stability import MAP_BASE, column_limits, simulated_edges
+from .analysis.stability import MAP_BASE, column_limits, simulated_edges
 from .sweep import EXECUTORS, grid, read_results, run_sweep
 
 __all__ = ["main"]
@@ -35,7 +35,7 @@ def main(argv=None):
                          "integrator and timestep chosen per point, the estimate in the estimated_error column")
     a = parse_args(ap, argv)
     if a.accuracy is not None:
-        from mjeap.accuracy import check_accuracy
+        from .simulation.accuracy import check_accuracy
         check_accuracy(a.accuracy)
     out = Path(a.out)
     masses = np.linspace(0.0, 150e-6, a.masses)[1:]

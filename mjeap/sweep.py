@@ -30,11 +30,10 @@ from typing import Callable, Dict, Iterable, List, Optional, Sequence
 
 import numpy as np
 
-from . import csvio
-from .csvio import plain_cell
-from .errors import (DivergenceError, MjeapError, ParameterError, UnknownNameError, check_integer,
-                     sigterm_as_interrupt)
-from .outputs import hold
+from .io import csvio
+from .io.csvio import plain_cell
+from .errors import DivergenceError, MjeapError, ParameterError, UnknownNameError, check_integer, sigterm_as_interrupt
+from .io.outputs import hold
 
 EXECUTORS = ("processes", "serial", "dask")
 
@@ -91,7 +90,7 @@ def metric_max_tip_deflection(r, point, scene) -> float:
 def metric_estimated_error(r, point, scene) -> str:
     """With an ``accuracy`` target: the estimated error of the tip curvature relative to its
     swing and the model chosen for it, e.g. '0.0031 (12 segments, discrete, h = 0.00333 s)'
-    (:mod:`mjeap.accuracy`); '' without one."""
+    (:mod:`mjeap.simulation.accuracy`); '' without one."""
     a = r.meta.get("accuracy")
     if not a:
         return ""
@@ -146,8 +145,8 @@ def random_design(n: int, seed: int = 0, **ranges) -> List[dict]:
 def settings(base: Optional[dict] = None, metrics: Sequence[str] = ()) -> dict:
     """Everything besides a point's own parameters that changes its row: the fixed
     parameters (``base`` over the defaults), the metrics and the package version."""
-    from . import __version__
-    return {"base": {**PARAMETERS, **(base or {})}, "metrics": sorted(metrics), "mjeap": __version__}
+    from .versions import MJEAP_VERSION
+    return {"base": {**PARAMETERS, **(base or {})}, "metrics": sorted(metrics), "mjeap": MJEAP_VERSION}
 
 
 def point_id(point: dict, base: Optional[dict] = None, metrics: Sequence[str] = ()) -> str:
@@ -188,9 +187,9 @@ def evaluate(point: dict, metrics: Sequence[str] = ("peak_to_peak", "returns"), 
     """Run one point (``base`` filled in under it) and return its row: the parameters, the
     metrics, ``error`` (empty when it ran), ``wall_s`` and ``point_id``. Never raises for a
     failing point."""
-    from .discretize import Payload
-    from .rollout import rollout
-    from .scene import Scene
+    from .model.discretize import Payload
+    from .simulation.rollout import rollout
+    from .simulation.scene import Scene
 
     p = {**PARAMETERS, **(base or {}), **point}
     row = {"point_id": point_id(point, base, metrics), **point, "error": "", "wall_s": 0.0,
@@ -264,7 +263,7 @@ def _drop_torn_row(path: Path) -> None:
 
 def read_results(path) -> List[dict]:
     """Rows of a sweep CSV (strings, as given: the quote that keeps a spreadsheet from
-    running a text cell as a formula is dropped, :mod:`mjeap.csvio`; the header names the
+    running a text cell as a formula is dropped, :mod:`mjeap.io.csvio`; the header names the
     columns)."""
     with open(path, newline="") as fh:
         return [{plain_cell(k): plain_cell(v) for k, v in row.items()} for row in csv.DictReader(fh)]

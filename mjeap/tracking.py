@@ -22,7 +22,7 @@ from typing import Callable, Dict, List, Optional, Tuple
 import mujoco
 import numpy as np
 
-from .discretize import Payload
+from .model.discretize import Payload
 from .errors import ParameterError
 from .engines.frame import check_initial_curvature, one_voltage
 from .engines.loop import advance

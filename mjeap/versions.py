@@ -14,8 +14,10 @@ from __future__ import annotations
 
 import mujoco
 
-__all__ = ["MUJOCO_VERSION", "mujoco_major", "cable_available", "dm_control_problem", "newton_sparse_broken"]
+__all__ = ["MJEAP_VERSION", "MUJOCO_VERSION", "mujoco_major", "cable_available", "dm_control_problem", "newton_sparse_broken"]
 
+#: this package's version (``mjeap.__version__``), in every result's provenance
+MJEAP_VERSION = "0.1.0"
 MUJOCO_VERSION = mujoco.__version__
 
 

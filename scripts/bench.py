@@ -138,7 +138,7 @@ def bench_drives(n=20000):
 def bench_threaded():
     """Loop vs mujoco.rollout on the HAMR bimorph (open-loop piezo drive), 0.2 s of a
     100 V-biased sine, samples every 1 ms."""
-    from mjeap.rollout import rollout, rollout_batch
+    from mjeap.simulation.rollout import rollout, rollout_batch
     s = Scene("pzt-hamr-small")
     volts = [f"sine:20V@{f:g}Hz,offset=100V" for f in np.linspace(100, 1000, 16)]
     kw = dict(sample_interval=1e-3)
@@ -338,7 +338,7 @@ def bench_sweep(points=16, duration=2.0):
 def bench_native(repeats=2, map_points=8):
     from mjeap import Payload, rollout, rollout_batch
     from mjeap.drives import make_drive
-    from mjeap.stability import MAP_BASE
+    from mjeap.analysis.stability import MAP_BASE
     from mjeap.sweep import grid, run_sweep
     s = Scene("pedot-micro", orientation="up", payload=Payload(12.6e-6, 6.27e-3))
     args = dict(duration=20.0, initial_curvature=-303.0, progress=False)
@@ -404,9 +404,9 @@ def bench_accuracy(claim_cases=12):
     against the loop one by one, the stability map's points at 1e-2, where the native
     step's time goes, and the accuracy claim on seeded cases."""
     from mjeap import rollout, rollout_batch
-    from mjeap.accuracy import relative_difference
+    from mjeap.simulation.accuracy import relative_difference
     from mjeap.drives import make_drive
-    from mjeap.stability import MAP_BASE
+    from mjeap.analysis.stability import MAP_BASE
     from mjeap.sweep import grid, run_sweep
     from mjeap.validation.accuracy_claim import check_case, draw_cases, summarise
     wave, args = "square:1.5V@0.1Hz", dict(initial_curvature=-303.0, progress=False)

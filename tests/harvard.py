@@ -3,7 +3,7 @@ for the tests: the plates' voltage difference V (V = V_bias at full drive, V_sig
 the bending stiffness per width D from its layer formula, f31 its free value. None of it
 is the drive's code."""
 from mjeap import analytical as an
-from mjeap.catalog import get_actuator
+from mjeap.model.catalog import get_actuator
 
 F31 = 32.0          # Pa m/V, Jafferis 2015 free value (PZTBender2's f31_eff_f)
 

@@ -7,9 +7,9 @@ import numpy as np
 import pytest
 
 from mjeap import Scene
-from mjeap.accuracy import ACCURACY_RANGE, ErrorModel, Model, check_accuracy
+from mjeap.simulation.accuracy import ACCURACY_RANGE, ErrorModel, Model, check_accuracy
 from mjeap.errors import ParameterError
-from mjeap.rollout import rollout, rollout_batch
+from mjeap.simulation.rollout import rollout, rollout_batch
 from mjeap.validation.accuracy_claim import check_case, draw_cases, summarise
 
 FAST = dict(orientation="horizontal")          # pedot-micro horizontal, first mode 207 Hz
@@ -48,7 +48,7 @@ def test_a_target_chooses_the_model_and_the_result_says_so(tmp_path):
     assert r.meta["scene"]["segments"] == a["model"]["segments"]
     assert r.meta["scene"]["timestep"] == pytest.approx(a["model"]["timestep"])
     assert s.layout.segments == 20 and s.time == 0.0            # the user's scene is left as it was
-    from mjeap.recording import _meta_markdown
+    from mjeap.io.recording import _meta_markdown
     assert "estimated_error" in _meta_markdown(r.meta)
     assert (tmp_path / "a.rrd").stat().st_size > 0 and (tmp_path / "a.csv").stat().st_size > 0
 
@@ -74,7 +74,7 @@ def test_no_target_keeps_the_model_and_can_estimate_its_error():
     np.testing.assert_array_equal(r.tip_curvature, plain.tip_curvature)
     # against a converged run (40 segments at 1/8 of the step): within 3 x
     ref_scene = s.variant(40, s.timestep / 8, "discrete")
-    from mjeap.accuracy import relative_difference
+    from mjeap.simulation.accuracy import relative_difference
     from mjeap.drives import make_drive
     ref = rollout(ref_scene, "sine:1V@5Hz", 0.2, drive=make_drive(None, ref_scene),
                   sample_interval=float(r.time[1] - r.time[0]))

@@ -6,7 +6,7 @@ import pytest
 from mjeap import DEFAULT_UNITS, get_actuator, load_mjcf
 from mjeap import Scene
 from mjeap.assets import ASSET_DIR, asset_name, asset_xml, iter_assets
-from mjeap.mjcf import arena_bytes
+from mjeap.model.mjcf import arena_bytes
 
 ASSETS = list(iter_assets())
 

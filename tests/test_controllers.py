@@ -47,7 +47,7 @@ def test_unreachable_reference_saturates_with_a_warning(tmp_path):
     r = rollout(scene, None, 10.0, controller=CurvatureTracker(big, 10.0), progress=False, rrd=tmp_path / "sat.rrd")
     assert r.meta["saturated_updates"] > 0 and "clipped" in r.meta["warnings"][0]
     assert np.abs(r.voltage).max() == pytest.approx(max(abs(v) for v in scene.actuator.voltage_range))
-    from mjeap.recording import read_recording
+    from mjeap.io.recording import read_recording
     assert "/log" in read_recording(tmp_path / "sat.rrd")
 
 

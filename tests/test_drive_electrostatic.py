@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from mjeap import Scene, analytical as an, rollout
-from mjeap.catalog import PVDF_60
+from mjeap.model.catalog import PVDF_60
 from mjeap.drives import make_drive
 from mjeap.drives.electrostrictive import maxwell_stress_model
 
@@ -107,7 +107,7 @@ def test_piezo_resonance_against_table_1(capsys):
     """First resonance of the physical parameter set (no residual) beside seed 003 Table 1,
     printed; the modal analysis converges with the chain (20 vs 40 hinges within 0.5 %). With
     the catalog's residual tip mass the model resonates at Table 1's frequency within 2 %."""
-    from mjeap.calibration import with_residual
+    from mjeap.analysis.calibration import with_residual
     lines = []
     for a, f_meas in TABLE_1.items():
         phys = with_residual(Scene(a).actuator, 0.0)
@@ -127,7 +127,7 @@ def test_residual_tip_mass_calibration_reproduces_the_catalog(actuator):
     the catalog scene rings at Table 1's frequency within 2 % (an independent measurement of
     what the modal analysis fitted); and the residual leaves the free deflection at Wood's
     (1 + 2 l_r) closed form (5 %): a tip mass adds no lever arm."""
-    from mjeap.calibration import calibrate_tip_mass
+    from mjeap.analysis.calibration import calibrate_tip_mass
     from mjeap.validation.mechanics import free_vibration_frequency as measured_frequency
     f_table = TABLE_1[actuator]
     cal = calibrate_tip_mass(actuator, f_table)

@@ -52,7 +52,7 @@ def test_first_mode_damping_ratio_is_the_catalogs_under_either_integrator(integr
     does per step, integrator included; mjeap.modes.first_mode_damping) is the catalog's
     zeta_1 = 0.05 within 2 %, unloaded horizontal. Under 'discrete' backward Euler adds
     zeta = omega h / 2 of its own (Rayleigh beta = h): the joints carry beta - h."""
-    from mjeap.modes import first_mode_damping, linearize
+    from mjeap.model.modes import first_mode_damping, linearize
     s = Scene("pedot-micro", integrator=integrator)
     w, zeta = first_mode_damping(linearize(s.model), s.model.dof_damping, s.model.opt.timestep, integrator)
     assert zeta == pytest.approx(0.05, rel=0.02)
@@ -66,7 +66,7 @@ def test_first_mode_damping_ratio_is_the_catalogs_under_gravity_loads(orientatio
     stiffness moves omega_1 by a factor 0.55 (up) to 1.3 (down); the first mode of the step
     map still has the catalog's zeta_1 = 0.05 within 2 % (it had zeta (w_el / w_1)^2:
     0.16 up, 0.03 down, when beta was 2 zeta / w_1 on the elastic stiffness only)."""
-    from mjeap.modes import first_mode_damping, linearize
+    from mjeap.model.modes import first_mode_damping, linearize
     s = Scene("pedot-micro", orientation=orientation, payload="100mg@6mm", integrator=integrator)
     w, zeta = first_mode_damping(linearize(s.model), s.model.dof_damping, s.model.opt.timestep, integrator)
     assert zeta == pytest.approx(0.05, rel=0.02)

@@ -17,7 +17,7 @@ import pytest
 from mjeap import ParameterError, Scene, rollout, rollout_batch
 from mjeap.cli import main
 from mjeap.sweep import grid, run_sweep
-from mjeap.system import System, attach
+from mjeap.simulation.system import System, attach
 
 ROOT = Path(__file__).resolve().parent.parent
 

@@ -6,7 +6,7 @@ from dm_env import test_utils
 
 from mjeap import ParameterError, Payload, Scene, rollout
 from mjeap.environment import make_environment, run_episode
-from mjeap.recording import read_recording
+from mjeap.io.recording import read_recording
 
 pytestmark = pytest.mark.dm_control  # dm_control's Physics: MuJoCo 3.x (mjeap.versions)
 

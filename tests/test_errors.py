@@ -4,7 +4,7 @@ from dataclasses import replace
 import pytest
 
 from mjeap import ParameterError, Payload, Scene, UnknownNameError, get_actuator
-from mjeap.catalog import PEDOT_MICRO
+from mjeap.model.catalog import PEDOT_MICRO
 from mjeap.cli import main
 
 

@@ -14,8 +14,8 @@ import pytest
 
 from mjeap.drives.electrostrictive import STRAIN_COEFFICIENT
 
-from mjeap.rollout import rollout
-from mjeap.scene import Scene
+from mjeap.simulation.rollout import rollout
+from mjeap.simulation.scene import Scene
 from mjeap.validation import golden
 
 FOLDER = Path(__file__).parent / "golden"

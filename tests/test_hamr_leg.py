@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from mjeap.controllers.hamr_leg import SWING, leg_scene, pid_gains, run_leg
-from mjeap.recording import read_recording
+from mjeap.io.recording import read_recording
 from mjeap.validation.mechanics import free_vibration_frequency
 
 #: seed 003: within 5 degrees in under 25 cycles (250 ms) at 100 Hz

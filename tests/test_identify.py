@@ -7,7 +7,7 @@ from scipy import signal
 
 from mjeap import ParameterError, Scene
 from mjeap.cli import main
-from mjeap.identify import fit_hinge_parameters, fit_step_response, read_columns, simulate_tip
+from mjeap.analysis.identify import fit_hinge_parameters, fit_step_response, read_columns, simulate_tip
 
 TRUTH = dict(gain=63.0, zero=0.52, pole_mechanical=0.3, pole_electrical=1.8)   # seed 000, eq. 8
 

@@ -17,7 +17,7 @@ from mjeap import Scene, rollout, rollout_batch
 from mjeap.assets import ASSET_DIR
 from mjeap.drives import make_drive
 from mjeap.errors import ParameterError
-from mjeap.fields import read_units
+from mjeap.model.fields import read_units
 from mjeap.validation import golden
 
 CASES = [  # actuator, scene kwargs, waveform, duration s, initial curvature 1/m, tolerance (of the swing)
@@ -144,7 +144,7 @@ def test_native_model_is_checked_for_stability():
     the spectral radius of the native step map is checked when it is built."""
     s = Scene("pedot-micro", orientation="up", payload="12.6mg@6.27mm")
     nat = s.native_model(make_drive(None, s))
-    from mjeap.modes import linearize, spectral_radius
+    from mjeap.model.modes import linearize, spectral_radius
     rho = spectral_radius(linearize(nat.model), nat.model.dof_damping, nat.model.opt.timestep, "implicitfast")
     assert rho <= 1.0
     assert nat.model.nv == 2 * s.layout.segments and nat.model.nu == 1

@@ -21,7 +21,7 @@ import pytest
 from mjeap import Scene, rollout
 from mjeap.cli import main
 from mjeap.errors import ParameterError
-from mjeap.recording import read_recording
+from mjeap.io.recording import read_recording
 
 ENV = {**os.environ, "PYTHONPATH": os.pathsep.join([os.path.dirname(os.path.dirname(__file__)),
                                                      os.environ.get("PYTHONPATH", "")])}
@@ -223,7 +223,7 @@ def test_csv_cells_a_spreadsheet_would_run_are_neutralised_and_read_back(tmp_pat
 
 
 def test_rollout_csv_headers_are_neutralised_and_numbers_kept(tmp_path):
-    from mjeap.csvio import read_rows
+    from mjeap.io.csvio import read_rows
     r = rollout(Scene("pedot-micro"), "step:-1V", 0.02)
     evil = "=HYPERLINK(\"http://x\",\"y\") (V)"
     r.signals = {evil: np.full(len(r.time), -1.5), "@SUM(A1) (A)": np.zeros(len(r.time))}
@@ -238,7 +238,7 @@ def test_rollout_csv_headers_are_neutralised_and_numbers_kept(tmp_path):
 
 
 def test_safe_cells_read_back_as_written():
-    from mjeap.csvio import plain_cell, safe_cell
+    from mjeap.io.csvio import plain_cell, safe_cell
     texts = ["=1+1", "+1 x", "-x", "@SUM(A1)", "\t=1", "\r=1", "'=1", "''@x", "'", "'x", "x", "", "-", "+",
              "=", "pedot-micro", "{\"base\": 1}"]
     for t in texts:

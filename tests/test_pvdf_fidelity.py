@@ -6,10 +6,8 @@ import pytest
 
 from mjeap import Scene, get_actuator
 from mjeap.drives import make_drive
-from mjeap.drives.electrostrictive import (FIELDS, SLOPES, STRAIN_COEFFICIENT, maxwell_stress_model,
-                                           section_moment_of_inertia)
-from mjeap.validation.metello2020 import (FIT_SAMPLE, SAMPLES, TABLE_4_6, active_share_of_ei,
-                                          fit_strain_coefficient, load_displacement, held, settle_tip)
+from mjeap.drives.electrostrictive import (FIELDS, SLOPES, STRAIN_COEFFICIENT, maxwell_stress_model, section_moment_of_inertia)
+from mjeap.validation.metello2020 import (FIT_SAMPLE, SAMPLES, TABLE_4_6, active_share_of_ei, fit_strain_coefficient, load_displacement, held, settle_tip)
 
 
 def test_layer_sum_moment_of_inertia_is_the_thesis_table_3_7():

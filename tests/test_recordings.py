@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 from mjeap import Scene, rollout
-from mjeap.recording import deformation_scale, read_blueprint, read_recording, scale_bar_length
+from mjeap.io.recording import deformation_scale, read_blueprint, read_recording, scale_bar_length
 
 UNIT = re.compile(r"\(([^)]+)\)\s*$")
 
@@ -91,7 +91,7 @@ def test_validation_recordings_show_checks_figure_and_beams(tmp_path):
 
 
 def test_system_recording_has_a_group_per_actuator_and_every_body(tmp_path):
-    from mjeap.system import System, attach
+    from mjeap.simulation.system import System, attach
     spec = mujoco.MjSpec.from_string(
         '<mujoco><option gravity="0 0 -0.00980665"/><worldbody><site name="a"/><site name="b" pos="0 3 0"/>'
         '<body name="ball" pos="3 1.5 0"><freejoint/><geom type="sphere" size="0.3" mass="1"/></body>'

@@ -226,7 +226,7 @@ def test_malformed_options_get_a_clear_error(tmp_path, capsys):
 def test_a_scene_past_the_buckling_load_says_so(tmp_path, capsys):
     """150 mg standing up is above the instantaneous column load (132 mg): the run's
     metadata, the CLI and the recording warn that it starts from an unstable equilibrium."""
-    from mjeap.recording import read_recording
+    from mjeap.io.recording import read_recording
     s = Scene("pedot-micro", orientation="up", payload="150mg@6.27mm")
     assert s.choice.buckled
     r = rollout(s, "step:0V", 0.05, rrd=tmp_path / "b.rrd")
@@ -377,7 +377,7 @@ def test_sigterm_ends_a_rollout_cleanly_with_its_outputs(tmp_path):
     _, err = p.communicate(timeout=60)
     assert p.returncode != 0
     assert rrd.stat().st_size > 0 and len(csvp.read_text().splitlines()) > 2     # what was simulated is written
-    from mjeap.recording import read_recording
+    from mjeap.io.recording import read_recording
     texts = [x for b in read_recording(rrd)["/log"] for x in b.column(b.schema.names.index("TextLog:text")).to_pylist()]
     assert any("Terminated" in str(t) for t in texts)
 

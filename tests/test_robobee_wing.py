@@ -6,7 +6,7 @@ import pytest
 
 import harvard
 from mjeap import Scene
-from mjeap.discretize import Payload
+from mjeap.model.discretize import Payload
 from mjeap.robots import robobee_wing as robobee
 
 

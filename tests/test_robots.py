@@ -8,7 +8,7 @@ import pytest
 from mjeap import robots
 from mjeap.cli import main
 from mjeap.errors import UnknownNameError
-from mjeap.system import System
+from mjeap.simulation.system import System
 
 
 def test_the_registry_holds_the_three_robots_with_tags():

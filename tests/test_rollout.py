@@ -2,10 +2,9 @@
 import numpy as np
 import pytest
 
-from mjeap import (DRIVES, DivergenceError, Drive, ParameterError, Scene, UnknownNameError, parse_waveform,
-                   register_drive, rollout)
+from mjeap import (DRIVES, DivergenceError, Drive, ParameterError, Scene, UnknownNameError, parse_waveform, register_drive, rollout)
 from mjeap.cli import main
-from mjeap.recording import read_recording
+from mjeap.io.recording import read_recording
 
 
 def scalars(rec, entity):

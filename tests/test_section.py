@@ -3,8 +3,8 @@ from dataclasses import replace
 
 import pytest
 
-from mjeap.catalog import CATALOG, PVDF_60, PVDF_60_HALF, PVDF_130, PZT_HAMR_LARGE
-from mjeap.section import SectionLayer, multilayer_section
+from mjeap.model.catalog import CATALOG, PVDF_60, PVDF_60_HALF, PVDF_130, PZT_HAMR_LARGE
+from mjeap.model.section import SectionLayer, multilayer_section
 
 L_FREE = 52e-3  # m, thesis Table 3.4
 

@@ -7,7 +7,7 @@ from mjeap.controllers.self_sensing import SelfSensingEstimator, calibrate, quas
 from mjeap import Scene, rollout
 from mjeap.drives import make_drive
 from mjeap.errors import ParameterError
-from mjeap.frequency import phasor, sine_sweep
+from mjeap.analysis.frequency import phasor, sine_sweep
 
 #: the paper's free-actuator bias voltages (Fig. 6) and its 10-2000 Hz range
 BIASES = (20.0, 60.0, 100.0)

@@ -10,8 +10,8 @@ import pytest
 
 from mjeap import Scene, load_mjcf, rollout, rollout_batch
 from mjeap.errors import MjeapError, ParameterError
-from mjeap.fields import read_units
-from mjeap.system import System, attach
+from mjeap.model.fields import read_units
+from mjeap.simulation.system import System, attach
 
 G = "0 0 -0.00980665"      # standard gravity in mm / ms^2
 VERTICAL = '<site name="mount" quat="0.7071068 0.7071068 0 0"/>'   # deflection along z: gravity bends it
@@ -65,7 +65,7 @@ def test_system_timestep_below_the_twins_keeps_the_damping_ratio():
     """A System stepped finer than its discrete twin gives the joints beta - h of its own h:
     the first mode of the step map keeps the catalog's 0.05 (it had beta - h_twin + h_system:
     0.036 at half the twin's step)."""
-    from mjeap.modes import first_mode_damping, linearize
+    from mjeap.model.modes import first_mode_damping, linearize
     spec = host(VERTICAL)
     a = attach(spec, "pedot-micro", site="mount", prefix="a", passive=True, integrator="discrete", contact=False)
     s = System(spec, [a], timestep=a.twin.timestep / 2)

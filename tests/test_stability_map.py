@@ -13,7 +13,7 @@ from pathlib import Path
 
 import pytest
 
-from mjeap.stability import MAP_BASE, column_limits, simulated_edges
+from mjeap.analysis.stability import MAP_BASE, column_limits, simulated_edges
 from mjeap.sweep import read_results, run_sweep
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -50,7 +50,7 @@ def test_script_writes_report_image_and_recording(tmp_path):
     report = (out / "report.md").read_text()
     assert "![stability map](stability_map.png)" in report and "relaxed EI" in report
     assert (out / "stability_map.png").stat().st_size > 10_000
-    from mjeap.recording import read_blueprint, read_recording
+    from mjeap.io.recording import read_blueprint, read_recording
     rec = read_recording(out / "stability_map.rrd")
     assert "/figure" in rec and "/report" in rec
     # laid out: the report beside the figure (axes and units), no bare 2D scatter

@@ -10,7 +10,7 @@ import pytest
 
 from mjeap import Scene, UnitSystem, rollout
 from mjeap.errors import ParameterError, UnknownNameError
-from mjeap.system import ContactParameters, System, attach
+from mjeap.simulation.system import ContactParameters, System, attach
 
 G = "0 0 -0.00980665"      # standard gravity in mm / ms^2
 
@@ -44,7 +44,7 @@ def test_attached_at_a_tilted_site_moves_as_its_scene(contact, integrator):
 
 def _native_actuators():
     from mjeap.engines.native import why_not
-    from mjeap.catalog import actuator_ids
+    from mjeap.model.catalog import actuator_ids
     from mjeap.drives import make_drive
     return [a for a in actuator_ids() if why_not(Scene(a), make_drive(None, Scene(a))) is None]
 
@@ -203,7 +203,7 @@ def test_a_controller_drives_the_system_as_the_waveform_it_returns():
     """A controller returning the square wave's value before every step gives the same run
     as the waveform (to round-off); one returning a voltage outside the drive's safe range
     stops the run with the actuator, the voltage and the range named."""
-    from mjeap.waveforms import parse_waveform
+    from mjeap.drives.waveforms import parse_waveform
     spec = host('<site name="mount"/>')
     a = attach(spec, "pedot-micro", site="mount", prefix="act", contact=False)
     s = System(spec, [a])
@@ -220,7 +220,7 @@ def test_a_controller_drives_the_system_as_the_waveform_it_returns():
 
 def test_transmission_inputs_are_named():
     """add_transmission refuses a zero or non-finite ratio and an unknown joint, naming them."""
-    from mjeap.system import add_transmission
+    from mjeap.simulation.system import add_transmission
     spec = host('<site name="mount"/><body name="arm"><joint name="stroke" type="hinge"/>'
                 '<geom type="sphere" size="1" contype="0" conaffinity="0"/></body>')
     a = attach(spec, "pzt-robobee", site="mount", prefix="act", contact=False)

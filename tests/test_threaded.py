@@ -9,7 +9,7 @@ import pytest
 
 from mjeap import Scene
 from mjeap.errors import DivergenceError, ParameterError
-from mjeap.rollout import rollout, rollout_batch
+from mjeap.simulation.rollout import rollout, rollout_batch
 from mjeap.engines import threaded
 
 OPEN_LOOP = [

@@ -81,7 +81,7 @@ def test_run_validation_writes_report_json_figures_and_recordings(tmp_path):
     assert "joint stiffness k" in md
     for e in exps:
         assert (tmp_path / f"{e.name}.rrd").stat().st_size > 0
-    from mjeap.recording import read_recording
+    from mjeap.io.recording import read_recording
     ents = read_recording(tmp_path / "mutlu2013-identify.rrd")
     assert "/checks" in ents and any(k.startswith("/tip_deflection") for k in ents)
 

@@ -13,7 +13,7 @@ on_4 = pytest.mark.skipif(cable_available(), reason="MuJoCo 3.x: the cable and d
 def test_every_result_names_the_mujoco_it_ran_on():
     r = rollout(Scene("pedot-micro", segments=6), "step:1V", 0.005)
     assert r.meta["mujoco"] == mujoco.__version__ == MUJOCO_VERSION
-    from mjeap.recording import _meta_markdown
+    from mjeap.io.recording import _meta_markdown
     assert f"| mujoco | {mujoco.__version__} |" in _meta_markdown(r.meta)
 
 
@@ -43,7 +43,7 @@ def test_dm_env_on_mujoco_4_is_refused_naming_the_versions():
 def test_contact_system_runs_on_mujoco_4():
     """MuJoCo 4.0.0's sparse Cholesky bug made the Newton solver diverge on a gripping
     system (fixed upstream in 4.0.1); mjeap builds systems with a dense Jacobian there."""
-    from mjeap.system import System, attach
+    from mjeap.simulation.system import System, attach
     from test_system import GRIP, host
     spec = host(GRIP)
     s = System(spec, [attach(spec, "pedot-micro", site=n, prefix=n) for n in ("left", "right")])

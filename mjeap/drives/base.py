@@ -100,9 +100,11 @@ class ExactLTI:
 
 
 class Drive:
-    """Base class. Subclasses set ``name``, ``actuators`` (catalog ids the source
-    describes), ``PARAMETERS`` (per actuator: defaults with their sources) and implement
-    :meth:`reset` and :meth:`step`."""
+    """A drive stepped with the beam (what the loop engine needs): subclasses set ``name``,
+    ``actuators`` (catalog ids the source describes), ``PARAMETERS`` (per actuator:
+    defaults with their sources) and implement :meth:`reset` and :meth:`step`. What the
+    other engines need is mixed in: :class:`OpenLoop` (threaded), :class:`NativeForm`
+    (native, systems)."""
 
     name: ClassVar[str] = ""
     actuators: ClassVar[Tuple[str, ...]] = ()
@@ -212,11 +214,29 @@ class Drive:
                                  f"values in the safe range [{lo:g}, {hi:g}] V of {self.scene.actuator.id} "
                                  f"under {self.name}")
 
-    # -- open loop (MuJoCo's threaded rollout, mjeap.engines.threaded) ---------------------------
+    # -- what the other engines ask (the mixins below answer yes) -------------------------
     def closed_loop_reason(self) -> Optional[str]:
         """None where the moments follow from the voltage alone and the drive leaves the
-        model unchanged, so their history can be computed before the run; else why not."""
+        model unchanged, so their history can be computed before the run (the threaded
+        engine, :class:`OpenLoop`); else why not."""
         return "its moments depend on the beam's state (the drive does not declare itself open-loop)"
+
+    def native_reason(self) -> Optional[str]:
+        """None where the drive has a native MJCF form (:class:`NativeForm`); else why not."""
+        return f"the {self.name} drive declares no native MJCF form"
+
+    def describe(self) -> str:
+        return f"{self.name} ({self.model_used})" if self.model_used else self.name
+
+
+class OpenLoop:
+    """A drive whose moments follow from the voltage alone (the threaded engine's need,
+    :mod:`mjeap.engines.threaded`): their whole history is computed up front
+    (:meth:`open_loop_moments`) and the drive can be put in its state after any step
+    (:meth:`seek`). Mixed in before :class:`Drive`."""
+
+    def closed_loop_reason(self) -> Optional[str]:
+        return None
 
     def open_loop_moments(self, v_steps: np.ndarray) -> np.ndarray:
         """Bending moment (N m) at every hinge over every step from reset, (steps, segments),
@@ -242,10 +262,15 @@ class Drive:
     def _restore_before(self, k: int) -> None:
         """Set the drive's own state to what it is before step ``k`` (none by default)."""
 
-    # -- native form: the drive as MuJoCo elements (mjeap.native) -------------------------
+
+class NativeForm:
+    """A drive that can be compiled into the model as MuJoCo elements (the native engine's
+    and :class:`mjeap.System`'s need, :mod:`mjeap.native`): :meth:`add_native` and the
+    read-outs of its state from a native run. The defaults replay the loop drive, for a
+    drive that is also :class:`OpenLoop`. Mixed in before :class:`Drive`."""
+
     def native_reason(self) -> Optional[str]:
-        """None where the drive has a native MJCF form (:meth:`add_native`); else why not."""
-        return f"the {self.name} drive declares no native MJCF form"
+        return None
 
     def add_native(self, spec, joints, parent: str):
         """Add the drive to ``spec`` (the scene's, internal units) as MuJoCo elements acting
@@ -266,7 +291,7 @@ class Drive:
         """The drive's signals after step ``k`` of a native run, the part holding that
         state: by default the loop drive replayed to step k (:meth:`seek`) on a read-only
         view of its part, so that the replay adds no moment or stiffness to a beam the
-        native model already drives (a system's, :mod:`mjeap.system`)."""
+        native model already drives (a system's, :mod:`mjeap.simulation.system`)."""
         own = self.part
         self.part = ReadOnlyPart(own)
         try:
@@ -287,9 +312,6 @@ class Drive:
         state and apply the last step's moments to the drive's own part (the scene), as the
         loop leaves them; by default the loop drive replayed to step k."""
         self.seek(k)
-
-    def describe(self) -> str:
-        return f"{self.name} ({self.model_used})" if self.model_used else self.name
 
 
 class ReadOnlyPart:

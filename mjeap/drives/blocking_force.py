@@ -15,7 +15,7 @@ import numpy as np
 from scipy import signal
 
 from ..errors import ParameterError
-from .base import Drive, ExactLTI, register_drive
+from .base import Drive, NativeForm, OpenLoop, ExactLTI, register_drive
 
 _EST = "estimate (seed 001 gives no extractable number; actuator reference: a few tenths of a mN to ~1 mN at 1 V)"
 
@@ -37,7 +37,7 @@ class VoltageTable:
 
 
 @register_drive
-class BlockingForceDrive(Drive):
+class BlockingForceDrive(OpenLoop, NativeForm, Drive):
     name = "blocking-force"
     actuators = ("ppy-trilayer",)
     model_used = "uniform moment (2/3) F_B L from a first-order blocking force"
@@ -80,7 +80,7 @@ class BlockingForceDrive(Drive):
 
     def add_native(self, spec, joints, parent):
         """M = (2/3) L F_1 a with the activation a the voltage low-passed over tau."""
-        from .. import native
+        from . import native
         u = self.scene.units
         F1, tau = float(self.params["blocking_force_per_volt"]), float(self.params["time_constant"])
         native.add_bending_tendon(spec, joints, np.ones(len(joints)))

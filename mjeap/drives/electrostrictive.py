@@ -30,7 +30,7 @@ from typing import Dict
 import numpy as np
 
 from ..errors import ParameterError
-from .base import Drive, register_drive
+from .base import Drive, OpenLoop, register_drive
 
 EPS0 = 8.8541878128e-12
 _T = "Metello 2020 (seed 002)"
@@ -81,7 +81,7 @@ def active_layer(actuator) -> int:
 
 
 @register_drive
-class ElectrostrictiveDrive(Drive):
+class ElectrostrictiveDrive(OpenLoop, Drive):
     name = "electrostrictive"
     actuators = ("pvdf-60", "pvdf-60-half", "pvdf-130")
     LAYERS = ("terpolymer",)

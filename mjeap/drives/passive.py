@@ -9,11 +9,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from .base import Drive, register_drive
+from .base import Drive, OpenLoop, register_drive
 
 
 @register_drive
-class PassiveDrive(Drive):
+class PassiveDrive(OpenLoop, Drive):
     name = "none"
     actuators = ()
     model_used = "no drive moment"

@@ -35,8 +35,8 @@ from typing import Dict
 import mujoco
 import numpy as np
 
-from .. import analytical as an
-from .base import Drive, register_drive
+from ..model import analytical as an
+from .base import Drive, NativeForm, OpenLoop, register_drive
 
 _J = "Jafferis et al. 2015: f31 ~ 32 Pa m/V free (24 blocked)"
 _C = ("estimate: seed 003 measures about half the 16 nF datasheet value for a fixed HAMR actuator; "
@@ -52,7 +52,7 @@ def _params(area_mm2: float):
 
 
 @register_drive
-class PiezoBimorphDrive(Drive):
+class PiezoBimorphDrive(OpenLoop, NativeForm, Drive):
     name = "piezo-bimorph"
     actuators = ("pzt-hamr-large", "pzt-hamr-small", "pzt-robobee")
     model_used = "unipolar simultaneous drive, Wood/Jafferis effective stress"
@@ -106,7 +106,7 @@ class PiezoBimorphDrive(Drive):
         ratios), gain Gamma_0 and bias -Gamma_0 V_bias / 2; a tendon-velocity sensor
         ``bend_rate`` gives the motional current Gamma_0 x its reading (the custom numeric
         ``mjeap_coupling`` holds Gamma_0 in N m/V, i.e. A s)."""
-        from .. import native
+        from . import native
         u = self.scene.units
         g0 = float(self.gamma[0])
         native.add_bending_tendon(spec, joints, self.gamma / g0)

@@ -23,16 +23,16 @@ import mujoco
 import numpy as np
 from scipy import signal
 
-from ..analytical import DadrasModel
+from ..model.analytical import DadrasModel
 from ..errors import ParameterError
-from .base import Drive, register_drive, zoh_first_order
+from .base import Drive, NativeForm, register_drive, zoh_first_order
 
 _SRC = "Dadras et al. 2021 (seed 000), eq. 8 (identified from a 3 V step)"
 _EQ8 = DadrasModel()      # the identified numbers live there, once
 
 
 @register_drive
-class RCRelaxationDrive(Drive):
+class RCRelaxationDrive(NativeForm, Drive):
     name = "rc-relaxation"
     actuators = ("pedot-micro",)
     model_used = "lumped RC + standard-linear-solid back-relaxation"
@@ -116,7 +116,7 @@ class RCRelaxationDrive(Drive):
         return p["zero"] * t, p["pole_mechanical"] * t, p["pole_electrical"] * t
 
     def add_native(self, spec, joints, parent):
-        from .. import native
+        from . import native
         u = self.scene.units
         z, pm, pe = self._internal_rates()
         native.add_bending_tendon(spec, joints, np.ones(len(joints)))

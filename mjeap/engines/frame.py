@@ -15,11 +15,11 @@ from typing import Callable, Dict, Optional, Union
 import mujoco
 import numpy as np
 
-from .. import csvio
-from ..analytical import arc_curvature
+from ..io import csvio
+from ..model.analytical import arc_curvature
 from ..errors import ParameterError, check_range
-from ..outputs import replacing
-from ..waveforms import Waveform, parse_waveform
+from ..io.outputs import replacing
+from ..drives.waveforms import Waveform, parse_waveform
 
 __all__ = ["RolloutResult", "Samples", "MAX_STEPS", "DEFAULT_SAMPLES", "check_work", "check_sampling",
            "voltage_steps", "to_waveform", "one_voltage", "check_initial_curvature", "sample_steps", "lockstep"]

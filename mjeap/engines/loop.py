@@ -14,7 +14,7 @@ import mujoco
 import numpy as np
 
 from ..errors import DivergenceError
-from . import Engine
+from .base import Engine
 from .frame import lockstep, one_voltage
 
 try:  # progress bars are optional

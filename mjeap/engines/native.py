@@ -8,8 +8,8 @@ from typing import Optional, Sequence
 import mujoco
 import numpy as np
 
-from ..drives.base import Drive
-from . import Engine
+from ..drives.base import NativeForm
+from .base import Engine
 from .threaded import LOADS, NATIVE_CONTROL, STATE, raise_bad, roll
 
 
@@ -58,7 +58,7 @@ def run_native(scene, native, drives: Sequence, v_steps: Sequence[np.ndarray], i
     for drv in drives:          # the drives' signals read the native model's state
         drv.part = part
     # drives that compute their signals from the states at the end keep those rows
-    batch = [type(drv).native_signal_history is not Drive.native_signal_history for drv in drives]
+    batch = [type(drv).native_signal_history is not NativeForm.native_signal_history for drv in drives]
     rows = [np.empty((len(sample_steps), state0.shape[1])) if bt else None for bt in batch]
     for b in range(B):
         native.drive = drives[b]

@@ -10,11 +10,11 @@ When it applies (:func:`why_not` says why not otherwise):
 * no controller (its voltage depends on the state) and no tip load set on the scene.
 
 How: the drive computes the moment history of the whole run up front
-(:meth:`Drive.open_loop_moments`, vectorised); it goes to ``mujoco.rollout`` as
+(:meth:`OpenLoop.open_loop_moments`, vectorised); it goes to ``mujoco.rollout`` as
 ``qfrc_applied`` controls, in internal units, and the states come back for every step, in
 chunks that keep memory bounded. Steps run in C, many rollouts share a thread pool. The
 samples are read back by putting the sampled state into the scene's MjData
-(``mj_setState`` + ``mj_kinematics``) and the drive at that step (:meth:`Drive.seek`,
+(``mj_setState`` + ``mj_kinematics``) and the drive at that step (:meth:`OpenLoop.seek`,
 which replays the drive's own step), so they are the lockstep loop's read-outs exactly.
 """
 from __future__ import annotations
@@ -26,7 +26,7 @@ import numpy as np
 from mujoco import rollout as mj_rollout
 
 from ..errors import DivergenceError
-from . import Engine
+from .base import Engine
 
 STATE = mujoco.mjtState.mjSTATE_FULLPHYSICS
 CONTROL = mujoco.mjtState.mjSTATE_QFRC_APPLIED

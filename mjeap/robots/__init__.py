@@ -8,46 +8,21 @@ read-outs (SI) and its experiment's command line, tagged by what it shows.
     robots.get("robobee-wing").readouts["stroke_angle"](system)     # rad
 
 ``mjeap robot NAME [options]`` (or ``python scripts/NAME.py``) runs a robot's experiment.
-A new robot is one module here that calls :func:`register`.
+A new robot is one module here that calls :func:`register` (:mod:`mjeap.robots.registry`)
+and is named in ``_MODULES``.
 """
 from __future__ import annotations
 
 import importlib
-from dataclasses import dataclass, field
-from typing import Callable, Dict, List, Mapping, Optional, Tuple
+from typing import Dict, List, Optional
 
 from ..errors import UnknownNameError
+from .registry import _REGISTRY, Robot, register, summary
 
-__all__ = ["Robot", "register", "names", "get", "load", "summary"]
-
-
-@dataclass(frozen=True)
-class Robot:
-    """One robot: ``build(**options) -> System``; ``readouts``: name -> f(system), SI;
-    ``main(argv) -> None``: its experiment's command line (prints JSON, writes a recording)."""
-
-    name: str
-    summary: str
-    build: Callable
-    main: Callable
-    readouts: Mapping[str, Callable] = field(default_factory=dict)
-    tags: Tuple[str, ...] = ()
-
-
-_REGISTRY: Dict[str, Robot] = {}
 #: the modules that register the robots, imported on first use (they import SciPy and MjSpec code)
 _MODULES = ("gripper", "hamr_leg", "robobee_wing")
 
-
-def summary(doc: str) -> str:
-    """A module docstring's first paragraph on one line (a robot's summary, its CLI's description)."""
-    return " ".join(doc.split("\n\n")[0].split())
-
-
-def register(robot: Robot) -> Robot:
-    """Add ``robot`` to the registry (a module calls this once, at import)."""
-    _REGISTRY[robot.name] = robot
-    return robot
+__all__ = ["Robot", "register", "names", "get", "load", "summary"]
 
 
 def _loaded() -> Dict[str, Robot]:

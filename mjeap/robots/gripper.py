@@ -55,12 +55,12 @@ import mujoco
 import numpy as np
 from scipy import optimize
 
-from mjeap.analytical import DadrasModel
-from mjeap.cli import arg_number, arg_output, parse_args, run_script
-from mjeap.errors import ParameterError, check_range
-from mjeap.sweep import stop_workers, worker_signals
-from mjeap.robots import Robot, register, summary
-from mjeap.system import ContactParameters, System, attach
+from ..model.analytical import DadrasModel
+from ..cli import arg_number, arg_output, parse_args, run_script
+from ..errors import ParameterError, check_range
+from ..sweep import stop_workers, worker_signals
+from . import Robot, register, summary
+from ..simulation.system import ContactParameters, System, attach
 
 BEAD_RADIUS = 0.75e-3         # m
 BEAD_DENSITY = 7850.0         # kg/m^3, steel
@@ -264,7 +264,7 @@ def write_recording(path, system: System, run: GripRun, reference: np.ndarray) -
     the bead's and the base's rise."""
     import rerun as rr
     import rerun.blueprint as rrb
-    from mjeap.recording import write_system_recording, x_axis, y_axis
+    from ..io.recording import write_system_recording, x_axis, y_axis
 
     def extra(rec):
         tc = [rr.TimeColumn("time", duration=run.time)]
@@ -329,7 +329,7 @@ def contact_voltage(hold: float) -> float:
 
 def _check_voltage(a) -> None:
     """The held voltage: within pedot-micro's safe range, and enough to reach the bead."""
-    from mjeap.catalog import get_actuator
+    from ..model.catalog import get_actuator
     hold = 10.0 if a.quick else a.hold
     lo, hi = contact_voltage(hold), get_actuator("pedot-micro").voltage_range[1]
     try:

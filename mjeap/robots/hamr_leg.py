@@ -47,14 +47,13 @@ import mujoco
 import numpy as np
 from scipy import optimize
 
-from mjeap.controllers.hamr_leg import (LIFT, SWING, LegPhaseController, cycles_to_within, free_estimator, leg_scene,
-                                  phase_errors_per_cycle, phase_loop_gains)
-from mjeap import Scene
-from mjeap.cli import arg_integer, arg_output, parse_args, run_script
-from mjeap.errors import check_integer
-from mjeap.frequency import phasor
-from mjeap.robots import Robot, register, summary
-from mjeap.system import System, add_transmission, attach
+from ..controllers.hamr_leg import (LIFT, SWING, LegPhaseController, cycles_to_within, free_estimator, leg_scene, phase_errors_per_cycle, phase_loop_gains)
+from .. import Scene
+from ..cli import arg_integer, arg_output, parse_args, run_script
+from ..errors import check_integer
+from ..analysis.frequency import phasor
+from . import Robot, register, summary
+from ..simulation.system import System, add_transmission, attach
 
 ACTUATOR = "pzt-hamr-small"
 LEG_LENGTH = 10e-3            # m, assumed (see the module text)
@@ -237,7 +236,7 @@ def write_recording(path, system: System, run: dict) -> None:
     ellipse (white), the foot's swing and lift against time, and the phase errors per cycle."""
     import rerun as rr
     import rerun.blueprint as rrb
-    from mjeap.recording import write_system_recording
+    from ..io.recording import write_system_recording
 
     ts, feet, n_open = run["time"], run["foot"], run["open_loop_cycles"]
     n_cyc = len(next(iter(run["errors"].values()))["true_deg"])

@@ -36,10 +36,10 @@ import sys
 import mujoco
 import numpy as np
 
-from mjeap.controllers.self_sensing import calibrate_on_free_actuator
-from mjeap.cli import arg_output, parse_args, run_script
-from mjeap.robots import Robot, register, summary
-from mjeap.system import System, add_transmission, attach
+from ..controllers.self_sensing import calibrate_on_free_actuator
+from ..cli import arg_output, parse_args, run_script
+from . import Robot, register, summary
+from ..simulation.system import System, add_transmission, attach
 
 T_EFF = 4000.0                                  # rad/m, seed 003 section 6.1
 SPAN, CHORD, THICKNESS = 15e-3, 5e-3, 20e-6     # m (length, mean chord: secondary source; thickness drawn)
@@ -124,7 +124,7 @@ def write_recording(path, system, traces: dict) -> None:
     against frequency (Fig. 7(c)) is the JSON's 'sweeps'."""
     import rerun as rr
     import rerun.blueprint as rrb
-    from mjeap.recording import write_system_recording
+    from ..io.recording import write_system_recording
 
     colours = {"100V": [40, 110, 220], "200V": [220, 60, 60]}
 

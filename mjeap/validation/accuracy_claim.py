@@ -1,4 +1,4 @@
-"""The accuracy claim of :mod:`mjeap.accuracy`, checked against converged runs.
+"""The accuracy claim of :mod:`mjeap.simulation.accuracy`, checked against converged runs.
 
 Cases are drawn by a seeded generator (actuators with their own drives, payloads,
 orientations, waveforms as the sources drive them, targets log-uniform in 1e-4 .. 1e-2). Each case is run at its
@@ -18,10 +18,10 @@ from typing import List, Optional
 
 import numpy as np
 
-from ..accuracy import relative_difference
+from ..simulation.accuracy import relative_difference
 from ..drives import make_drive
-from ..rollout import rollout
-from ..scene import Scene
+from ..simulation.rollout import rollout
+from ..simulation.scene import Scene
 
 __all__ = ["Case", "draw_cases", "check_case", "summarise"]
 

@@ -12,11 +12,11 @@ from __future__ import annotations
 import numpy as np
 from scipy import signal
 
-from .. import analytical as an
-from ..discretize import Payload, clamp_rotation
+from ..model import analytical as an
+from ..model.discretize import Payload, clamp_rotation
 from ..errors import DivergenceError
-from ..rollout import rollout
-from ..scene import Scene
+from ..simulation.rollout import rollout
+from ..simulation.scene import Scene
 from .core import INDEPENDENT_SOLUTION, PUBLISHED_FORMULA, Experiment, experiment
 
 UP = clamp_rotation("up")

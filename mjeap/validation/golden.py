@@ -37,8 +37,8 @@ FOLDER = Path(__file__).resolve().parents[2] / "tests" / "golden"
 def simulate(actuator_id: str, engine: str = "loop") -> Tuple[np.ndarray, np.ndarray]:
     """(time s, tip curvature 1/m) of the actuator's scenario, SAMPLES + 1 samples, on the
     lockstep loop (the reference every other engine is tested against) or ``engine``."""
-    from ..rollout import rollout
-    from ..scene import Scene
+    from ..simulation.rollout import rollout
+    from ..simulation.scene import Scene
     kw, wave, duration, k0, params = SCENARIOS[actuator_id]
     scene = Scene(actuator_id, **kw)
     r = rollout(scene, wave, duration, drive_params=params, initial_curvature=k0, progress=False,

@@ -8,11 +8,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import analytical as an
-from ..calibration import clamp_stiffness_for_frequency, with_residual
-from ..discretize import block_inertia
-from ..rollout import rollout
-from ..scene import Scene
+from ..model import analytical as an
+from ..analysis.calibration import clamp_stiffness_for_frequency, with_residual
+from ..model.discretize import block_inertia
+from ..simulation.rollout import rollout
+from ..simulation.scene import Scene
 from .core import INDEPENDENT_SOLUTION, PUBLISHED_FORMULA, Experiment, experiment
 from .mechanics import free_vibration_frequency
 

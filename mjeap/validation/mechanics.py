@@ -6,10 +6,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import analytical as an
-from ..discretize import Payload
-from ..scene import Scene
-from ..section import multilayer_section  # noqa: F401  (documented reference)
+from ..model import analytical as an
+from ..model.discretize import Payload
+from ..simulation.scene import Scene
+from ..model.section import multilayer_section  # noqa: F401  (documented reference)
 from .core import INDEPENDENT_SOLUTION, PUBLISHED_FORMULA, PUBLISHED_NUMBER, Experiment, experiment
 
 ACT = "pedot-micro"
@@ -157,7 +157,7 @@ def buckling(quick: bool = False) -> Experiment:
 
 @experiment("mechanics-section")
 def section(quick: bool = False) -> Experiment:
-    from ..catalog import PVDF_60
+    from ..model.catalog import PVDF_60
     ex = Experiment("mechanics-section", "Multilayer cross-section of 60PVDF (thesis eqs. 3.1-3.6)")
     s = PVDF_60.section_at(0.0)
     ex.check("neutral axis z_c", "m", s.neutral_axis, 0.132e-3,

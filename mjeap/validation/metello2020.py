@@ -14,9 +14,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..drives import make_drive
-from ..catalog import get_actuator
+from ..model.catalog import get_actuator
 from ..drives.electrostrictive import FIELDS, SLOPES, active_layer, eigenstrain_moment, maxwell_stress_model
-from ..scene import Scene
+from ..simulation.scene import Scene
 from .core import PUBLISHED_FORMULA, Experiment, experiment
 
 THESIS = "Metello 2020 (seed 002)"

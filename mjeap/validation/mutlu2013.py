@@ -12,10 +12,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from .. import analytical as an
-from ..identify import fit_hinge_parameters, simulate_tip
-from ..rollout import rollout
-from ..scene import Scene
+from ..model import analytical as an
+from ..analysis.identify import fit_hinge_parameters, simulate_tip
+from ..simulation.rollout import rollout
+from ..simulation.scene import Scene
 from .core import INDEPENDENT_SOLUTION, PUBLISHED_FORMULA, Experiment, experiment
 
 PAPER = "Mutlu et al. 2013 (seed 001)"

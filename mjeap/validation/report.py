@@ -10,7 +10,7 @@ from typing import Optional, List
 
 import numpy as np
 
-from ..outputs import replacing
+from ..io.outputs import replacing
 from .core import REFERENCE_KINDS, Experiment
 
 #: beam frames per simulated run in an experiment's recording
@@ -108,7 +108,7 @@ def write_recording(ex: Experiment, path: Path, figure: Optional[Path] = None) -
 def _write_recording(ex: Experiment, path: Path, figure: Optional[Path]) -> None:
     import rerun as rr
     import rerun.blueprint as rrb
-    from ..recording import deformation_scale, y_axis
+    from ..io.recording import deformation_scale, y_axis
     panels = list(dict.fromkeys(c.panel for c in ex.curves))
     timed = [p for p in panels if any(c.xlabel.startswith("time") for c in ex.curves if c.panel == p)]
     untimed = [p for p in panels if p not in timed]

@@ -19,7 +19,7 @@ from typing import List
 
 import numpy as np
 
-from .errors import ParameterError
+from ..errors import ParameterError
 
 #: text a spreadsheet runs as a formula: one of these first, after any quotes (so that the
 #: quote added to it reads back unambiguously)

@@ -9,15 +9,13 @@ phase (rad), delay (s).
 """
 from __future__ import annotations
 
-
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Callable, Dict, Optional
 
 import numpy as np
 
-from .discretize import parse_quantity
-from .errors import ParameterError, UnknownNameError, check_positive, check_range
+from ..model.discretize import parse_quantity
+from ..errors import ParameterError, UnknownNameError, check_positive, check_range
 
 
 @dataclass(frozen=True)
@@ -89,7 +87,7 @@ class Waveform:
 
 
 def _csv_samples(path: str) -> tuple:
-    from .csvio import read_rows
+    from ..io.csvio import read_rows
     rows = read_rows(path, "csv")
     if len(rows) < 3:
         raise ParameterError("csv", path, "a CSV file with a header and at least 2 rows")

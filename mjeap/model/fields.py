@@ -9,8 +9,8 @@ from typing import Optional
 import mujoco
 import numpy as np
 
-from .errors import ParameterError
-from .units import UnitSystem
+from ..errors import ParameterError
+from ..units import UnitSystem
 
 __all__ = ["UNITS_FIELD", "DOF_DAMPING_FIELD", "add_units", "read_numeric", "read_units", "apply_dof_damping",
            "load_mjcf"]
@@ -59,7 +59,7 @@ def read_units(model: mujoco.MjModel) -> Optional[UnitSystem]:
 def apply_dof_damping(model: mujoco.MjModel) -> mujoco.MjModel:
     """Apply the per-dof Rayleigh damping stored in a generated model (cable), in place:
     ``mjeap_dof_damping`` holds one value per dof of the model, ``PREFIX/mjeap_dof_damping``
-    (a beam attached under ``PREFIX/``, :mod:`mjeap.system`) one per dof of the joints
+    (a beam attached under ``PREFIX/``, :mod:`mjeap.simulation.system`) one per dof of the joints
     named ``PREFIX/...``, in dof order. Values that are not finite and >= 0, or not one per
     dof, are refused with the field named."""
     for i in range(model.nnumeric):

@@ -10,7 +10,7 @@ Two representations sit behind one interface, :class:`BeamBuilder`:
   the geom's box section, divided by the distance to the previous body) and each body an
   explicit inertial.
 
-Both place their hinges by the midpoint rule of :mod:`mjeap.discretize`. Body frames: the
+Both place their hinges by the midpoint rule of :mod:`mjeap.model.discretize`. Body frames: the
 origin of link j is hinge j, local x runs along the beam, local y is the deflection
 (thickness) direction and local z the hinge (width) axis. Everything is written in the
 internal units of a :class:`~mjeap.units.UnitSystem`. A MuJoCo 4 backend (1D flexcomp rods)
@@ -25,8 +25,8 @@ import mujoco
 import numpy as np
 
 from .discretize import BeamLayout, Payload, block_inertia, clamp_rotation
-from .errors import ParameterError, UnknownNameError
-from .units import UnitSystem
+from ..errors import ParameterError, UnknownNameError
+from ..units import UnitSystem
 
 GRAVITY = 9.80665  # m/s^2
 BEAM_RGBA = [0.2, 0.45, 0.8, 1.0]
@@ -175,7 +175,7 @@ def get_builder(representation: str) -> BeamBuilder:
         builder = BUILDERS[representation]
     except KeyError:
         raise UnknownNameError("representation", str(representation), BUILDERS) from None
-    from .versions import MUJOCO_VERSION, cable_available
+    from ..versions import MUJOCO_VERSION, cable_available
     if representation == "cable" and not cable_available():
         raise ParameterError("representation", representation, "'hinge' on MuJoCo 4.x",
                              f"MuJoCo {MUJOCO_VERSION} removed the cable plugin and <composite> (1D flexcomp rods "
@@ -197,7 +197,7 @@ def build_spec(layout: BeamLayout, representation: str = "hinge", orientation: s
                gravity: bool = True, model_name: Optional[str] = None):
     """MjSpec of a clamped beam (internal units) and the handles of its parts.
 
-    Damping, timestep and integrator are set later by :mod:`mjeap.scene`, which derives
+    Damping, timestep and integrator are set later by :mod:`mjeap.simulation.scene`, which derives
     them from the compiled model.
     """
     units = units or UnitSystem()

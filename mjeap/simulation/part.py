@@ -16,8 +16,8 @@ from typing import Optional, Sequence, Union
 import mujoco
 import numpy as np
 
-from . import analytical
-from .errors import ParameterError, check_positive
+from ..model import analytical
+from ..errors import ParameterError, check_positive
 
 
 def as_slice(idx: np.ndarray):
@@ -222,7 +222,7 @@ class ActuatorPart:
     def set_hinge_parameters(self, stiffness=None, damping=None) -> None:
         """Set every hinge's bending stiffness (N m / rad) and/or viscous damping (N m s / rad),
         scalars or one value per hinge, replacing the catalog beam's (the joint-level view of
-        seed 001's model; see :mod:`mjeap.identify`). Hinge chain only. The timestep is not
+        seed 001's model; see :mod:`mjeap.analysis.identify`). Hinge chain only. The timestep is not
         re-chosen: a stiffer, less damped chain than the model was built for can diverge
         (the step then raises :class:`DivergenceError`)."""
         if self.representation != "hinge":

@@ -15,7 +15,7 @@ from typing import Tuple
 import numpy as np
 from scipy import integrate, optimize, signal
 
-from .errors import ParameterError, check_positive
+from ..errors import ParameterError, check_positive
 from .section import SectionLayer, SectionProperties, multilayer_section  # noqa: F401  (re-export)
 
 __all__ = [

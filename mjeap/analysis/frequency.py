@@ -12,7 +12,7 @@ from typing import Dict, Sequence
 
 import numpy as np
 
-from .errors import ParameterError, check_positive
+from ..errors import ParameterError, check_positive
 
 
 def phasor(t: np.ndarray, y: np.ndarray, frequency: float) -> complex:
@@ -68,7 +68,7 @@ def sine_sweep(scene, frequencies: Sequence[float], offset: float, amplitude: fl
     ``settle_time`` (s): transient allowed before the window, default five time constants
     of the first mode, 5 / (zeta omega_1).
     """
-    from .rollout import rollout
+    from ..simulation.rollout import rollout
 
     f = np.asarray(frequencies, float)
     if f.ndim != 1 or f.size == 0 or np.any(f <= 0):

@@ -5,11 +5,11 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from .component import ActuatorPart
-from .engines.native import why_not
-from .errors import ParameterError
-from .fields import add_units, apply_dof_damping
-from .modes import linearize, spectral_radius
+from .part import ActuatorPart
+from ..engines.native import why_not
+from ..errors import ParameterError
+from ..model.fields import add_units, apply_dof_damping
+from ..model.modes import linearize, spectral_radius
 
 __all__ = ["NativeModel"]
 

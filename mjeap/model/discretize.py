@@ -17,7 +17,7 @@ from typing import Optional, Tuple
 import numpy as np
 
 from .catalog import Actuator
-from .errors import ParameterError, check_positive, check_range
+from ..errors import ParameterError, check_positive, check_range
 
 #: density used for a payload whose size is not given: sintered NdFeB, as the magnets
 #: of seed 000 (literature default, 7.5 g/cm^3)

@@ -13,13 +13,12 @@ from typing import List, Optional, Sequence, Union
 import numpy as np
 
 from .accuracy import target_for
-from .engines import ENGINES, choose
-from .engines.frame import (DEFAULT_SAMPLES, MAX_INITIAL_BEND, MAX_STEPS, RolloutResult, Samples, check_initial_curvature,
-                            check_sampling, check_work, one_voltage, sample_steps, to_waveform, voltage_steps)
-from .errors import ParameterError, check_integer, check_positive
-from .outputs import check_outputs, guarded, write_outputs
+from ..engines import ENGINES, choose
+from ..engines.frame import (DEFAULT_SAMPLES, MAX_INITIAL_BEND, MAX_STEPS, RolloutResult, Samples, check_initial_curvature, check_sampling, check_work, one_voltage, sample_steps, to_waveform, voltage_steps)
+from ..errors import ParameterError, check_integer, check_positive
+from ..io.outputs import check_outputs, guarded, write_outputs
 from .scene import Scene
-from .waveforms import Waveform
+from ..drives.waveforms import Waveform
 
 __all__ = ["rollout", "rollout_batch", "free_vibration", "RolloutResult", "ENGINES", "MAX_STEPS", "DEFAULT_SAMPLES",
            "MAX_INITIAL_BEND", "check_work", "check_sampling", "check_outputs", "write_outputs", "one_voltage",
@@ -27,7 +26,7 @@ __all__ = ["rollout", "rollout_batch", "free_vibration", "RolloutResult", "ENGIN
 
 
 def _meta(scene, drv, wave, duration, initial_curvature, n_steps, engine) -> dict:
-    from .outputs import provenance
+    from ..io.outputs import provenance
     return {**provenance(), "actuator": scene.actuator.id, "drive": drv.describe(),
             "voltage": "closed loop" if wave is None else getattr(wave, "text", str(wave)),
             "duration_s": duration, "initial_curvature_per_m": initial_curvature, "steps": n_steps,
@@ -59,12 +58,12 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
 
     ``accuracy`` (default: the scene's own, if any): the largest error of the tip curvature
     relative to its swing; the run then chooses its segments, integrator and timestep
-    (:mod:`mjeap.accuracy`; ``scene`` is left as it was) and ``meta['accuracy']`` carries the
+    (:mod:`mjeap.simulation.accuracy`; ``scene`` is left as it was) and ``meta['accuracy']`` carries the
     model and its estimated error. Without one the scene's model runs; ``estimate_error``
     then estimates its error with a coarser companion run (about 0.35 x the cost).
     """
-    from .drives import make_drive
-    from . import recording
+    from ..drives import make_drive
+    from ..io import recording
 
     duration = check_positive("duration", duration, "s")
     initial_curvature = check_initial_curvature(initial_curvature, scene.layout.length)
@@ -115,10 +114,11 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
 def _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, csv_path, sample_interval,
                          check_every, controller, engine, max_steps, target, wave) -> RolloutResult:
     """:func:`rollout` at an accuracy target (or, without one, with its error estimated): the
-    runs of :mod:`mjeap.accuracy`, each with the drive ``drv`` names and its parameters;
+    runs of :mod:`mjeap.simulation.accuracy`, each with the drive ``drv`` names and its parameters;
     the outputs hold the chosen run, whose meta says how it was chosen."""
-    from . import accuracy as acc, recording
-    from .drives import make_drive
+    from . import accuracy as acc
+    from ..io import recording
+    from ..drives import make_drive
     params = dict(drv.params)
 
     def run(s, interval):
@@ -162,8 +162,8 @@ def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable
     applies. Same results as :func:`rollout` run one by one with that
     engine; raises ParameterError where neither applies. ``accuracy`` (default: the
     scene's own): one model is chosen for the whole batch, for its worst member
-    (:mod:`mjeap.accuracy`), and each result carries its own estimated error."""
-    from .drives import make_drive
+    (:mod:`mjeap.simulation.accuracy`), and each result carries its own estimated error."""
+    from ..drives import make_drive
     duration = check_positive("duration", duration, "s")
     if np.ndim(initial_curvatures) == 0:
         kappa0 = None

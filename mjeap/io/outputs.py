@@ -24,7 +24,7 @@ from contextlib import ExitStack, contextmanager
 from pathlib import Path
 from typing import Dict, Optional
 
-from .errors import OutputError, ParameterError, sigterm_as_interrupt
+from ..errors import OutputError, ParameterError, sigterm_as_interrupt
 
 _held: dict = {}                       # real path -> [(pid, thread), count, fd]
 _held_lock = threading.Lock()
@@ -204,8 +204,8 @@ def provenance() -> dict:
     """What every result's metadata (and so its recording and CSV's sidecar) says about the
     software that made it: the MuJoCo and mjeap versions."""
     import mujoco
-    from . import __version__
-    return {"mujoco": mujoco.__version__, "mjeap": __version__}
+    from ..versions import MJEAP_VERSION
+    return {"mujoco": mujoco.__version__, "mjeap": MJEAP_VERSION}
 
 
 def check_outputs(**paths) -> Dict[str, Path]:

@@ -2,7 +2,7 @@
 with other bodies and contact.
 
 :func:`attach` places a catalog (or user) actuator, with its drive compiled in
-(:mod:`mjeap.native`), into a user's ``MjSpec`` at a site, body or frame, under a prefix.
+(:mod:`mjeap.drives.native`), into a user's ``MjSpec`` at a site, body or frame, under a prefix.
 Its beam is discretised, damped and given a timestep exactly as a one-actuator
 :class:`~mjeap.Scene` in the same orientation (its *twin*, built with the mount's world
 rotation at the host's ``qpos0``), so an attached actuator moves as its Scene does.
@@ -28,16 +28,16 @@ from typing import Dict, List, Optional, Sequence, Union
 import mujoco
 import numpy as np
 
-from .native import NativeHandles
-from .component import ActuatorPart
-from .errors import DivergenceError, ParameterError, UnknownNameError, check_positive
-from .outputs import guarded, provenance
-from .versions import newton_sparse_broken
-from .engines.frame import one_voltage
-from .engines.native import why_not as native_why_not
-from .fields import UNITS_FIELD, add_units, apply_dof_damping
+from ..drives.native import NativeHandles
+from .part import ActuatorPart
+from ..errors import DivergenceError, ParameterError, UnknownNameError, check_positive
+from ..io.outputs import guarded, provenance
+from ..versions import newton_sparse_broken
+from ..engines.frame import one_voltage
+from ..engines.native import why_not as native_why_not
+from ..model.fields import UNITS_FIELD, add_units, apply_dof_damping
 from .scene import DEFAULT_SEGMENTS, INTEGRATORS, Scene, diverged
-from .units import DEFAULT_UNITS, UnitSystem
+from ..units import DEFAULT_UNITS, UnitSystem
 
 _PREFIX = re.compile(r"^[A-Za-z][A-Za-z0-9_-]*$")
 
@@ -229,13 +229,13 @@ def attach(spec: mujoco.MjSpec, actuator, *, prefix: str, site: Optional[str] = 
     ``site``, ``body`` or ``frame`` (exactly one, by name): its clamp frame is the mount's
     (x along the beam, y the deflection, z the hinge axis). ``prefix`` (letters, digits,
     '_', '-'; unique in the spec) is prepended as ``prefix/`` to every name. ``drive``
-    (default: the actuator's own) is compiled in (:mod:`mjeap.native`); ``passive=True``
+    (default: the actuator's own) is compiled in (:mod:`mjeap.drives.native`); ``passive=True``
     attaches the bare beam (the cable representation has no native drive). ``contact``
     lets the beam's geoms touch other bodies. ``units``: the host's internal units.
     ``integrator`` defaults to 'discrete' with contact (MuJoCo solves contacts in the
     metric of its implicit update there; under 'implicitfast' contact impulses are sized
     for M alone and kick the heavily damped short modes of a beam: tested) and
-    'implicitfast' without; the timestep and damping follow from it (:mod:`mjeap.scene`).
+    'implicitfast' without; the timestep and damping follow from it (:mod:`mjeap.simulation.scene`).
     The host's flags are read: under ``<flag gravity="disable"/>`` the beam is sized without
     gravity; springs or dampers switched off (and actuation, for a driven beam) are refused.
     With ``contact`` the beam's own parts (its payload, neighbouring links) never touch."""
@@ -261,7 +261,7 @@ def attach(spec: mujoco.MjSpec, actuator, *, prefix: str, site: Optional[str] = 
     if passive:
         child = twin.spec.copy()
     else:
-        from .drives import make_drive
+        from ..drives import make_drive
         drv = make_drive(drive, twin, **(drive_params or {}))
         why = native_why_not(twin, drv)
         if why is not None:
@@ -467,8 +467,8 @@ class System:
         voltage (V) held over each step, in lockstep with :meth:`step`, and its
         ``signals()`` (the drive current, A, ...) read what a lockstep loop would, e.g. for
         a controller that senses the actuator's own current."""
-        from .drives import make_drive
-        from .drives.base import ReadOnlyPart
+        from ..drives import make_drive
+        from ..drives.base import ReadOnlyPart
         i = self.index(prefix)
         a = self.actuators[i]
         if a.drive is None:
@@ -485,7 +485,7 @@ class System:
         k0 = self._per_actuator("initial_curvatures", initial_curvatures)
         m, d = self.model, self.data
         mujoco.mj_resetData(m, d)
-        from .engines.frame import check_initial_curvature
+        from ..engines.frame import check_initial_curvature
         for p, k in zip(self.parts, k0):
             p.apply_loads()
             k = check_initial_curvature(k, p.layout.length, "initial_curvatures")
@@ -609,8 +609,8 @@ class System:
         hold over it, one per actuator or a dict by prefix (None: unchanged); each is checked
         against its drive's safe range. It may read the system's state; a controller that
         senses an actuator's current steps a :meth:`drive_observer` with them."""
-        from .engines.frame import Samples, check_work, lockstep, sample_steps as steps_of, to_waveform, voltage_steps
-        from .outputs import write_outputs
+        from ..engines.frame import (Samples, check_work, lockstep, sample_steps as steps_of, to_waveform, voltage_steps)
+        from ..io.outputs import write_outputs
         duration = check_positive("duration", duration, "s")
         if controller is not None:
             if voltages is not None and any(v is not None for v in self._per_actuator("voltages", voltages)):
@@ -701,6 +701,6 @@ class System:
             res = SystemResult(samples[0].t[:n] if samples else np.zeros(0), results, names, pos[:n], quat[:n],
                                fc[:n], meta)
             if rrd is not None:
-                from .recording import write_system_recording
+                from ..io.recording import write_system_recording
                 write_outputs([(rrd, lambda: write_system_recording(rrd, res, self))], error, res)
         return res

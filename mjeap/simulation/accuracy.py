@@ -58,7 +58,7 @@ from typing import List, Optional
 
 import numpy as np
 
-from .errors import ParameterError
+from ..errors import ParameterError
 
 __all__ = ["QUANTITY", "ACCURACY_RANGE", "Model", "ErrorModel", "check_accuracy", "target_for", "relative_difference",
            "calibrate", "choose_model", "run_at_accuracy", "estimate_error"]
@@ -205,7 +205,7 @@ def choose_model(scene, error_model: ErrorModel, target: float, duration: float,
 
 
 def _check_work(model: Model, duration: float, target: float, em: ErrorModel) -> None:
-    from .engines.frame import MAX_STEPS
+    from ..engines.frame import MAX_STEPS
     n = duration / model.timestep
     if n > MAX_STEPS:
         raise ParameterError("accuracy", target, "a target this run can reach within "

@@ -16,7 +16,7 @@ from typing import Dict, Sequence
 
 import numpy as np
 
-from . import analytical as an
+from ..model import analytical as an
 
 #: the sweep base of seed 000's map: standing up, payload at l_e, 0.1 Hz square wave, 30 s
 #: (three periods)

@@ -19,10 +19,10 @@ import numpy as np
 import scipy.linalg
 from scipy import optimize
 
-from .catalog import Actuator, get_actuator
-from .errors import ParameterError, check_positive
-from .modes import linearize
-from .scene import Scene
+from ..model.catalog import Actuator, get_actuator
+from ..errors import ParameterError, check_positive
+from ..model.modes import linearize
+from ..simulation.scene import Scene
 
 
 @dataclass(frozen=True)

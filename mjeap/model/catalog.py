@@ -13,7 +13,7 @@ from typing import Dict, Optional, Tuple
 
 import numpy as np
 
-from .errors import ParameterError, UnknownNameError, check_positive
+from ..errors import ParameterError, UnknownNameError, check_positive
 from .section import SectionLayer, SectionProperties, multilayer_section
 
 SEED_000 = "Dadras et al. 2021, IEEE JMEMS 30(3) (seed 000)"

@@ -23,7 +23,7 @@ Damping and timestep are derived from the compiled model, never tuned by hand:
    chain therefore gets joint damping (beta - h) k, so that the first mode's damping ratio
    is still zeta_1, and its timestep is at most beta / 2 (the joint keeps at least half).
    ``discrete`` also solves contacts in the metric M + hD + h^2 K of the implicit update:
-   systems with contact need it (:mod:`mjeap.system`).
+   systems with contact need it (:mod:`mjeap.simulation.system`).
 4. The default timestep is min(T_1 / 50, T_el / 50, h_stab / 2): 50 steps per period of
    the first mode keeps its period error below 0.1 %; T_el bounds it near the buckling load,
    where T_1 grows without bound but the beam's elastic response to a drive does not; the
@@ -46,14 +46,14 @@ import numpy as np
 import scipy.linalg
 
 from .accuracy import check_accuracy
-from .catalog import Actuator, get_actuator
-from .component import ActuatorPart, write_hinge_angles
-from .discretize import BeamLayout, Payload, check_payload, clamp_rotation, discretize
-from .errors import DivergenceError, ParameterError, check_positive, check_range
-from .mjcf import build_spec, get_builder
-from .modes import linearize, modal_frequencies, stability_limit
-from .fields import DOF_DAMPING_FIELD, apply_dof_damping
-from .units import DEFAULT_UNITS, UnitSystem
+from ..model.catalog import Actuator, get_actuator
+from .part import ActuatorPart, write_hinge_angles
+from ..model.discretize import BeamLayout, Payload, check_payload, clamp_rotation, discretize
+from ..errors import DivergenceError, ParameterError, check_positive, check_range
+from ..model.mjcf import build_spec, get_builder
+from ..model.modes import linearize, modal_frequencies, stability_limit
+from ..model.fields import DOF_DAMPING_FIELD, apply_dof_damping
+from ..units import DEFAULT_UNITS, UnitSystem
 
 STEPS_PER_PERIOD = 50
 STABILITY_SAFETY = 0.5
@@ -118,7 +118,7 @@ class Scene:
     timestep is checked for stability; the hinge chain needs none), ``accuracy`` (a
     target for this scene's rollouts, relative to the swing of the tip curvature: they
     then choose segments, integrator and timestep themselves and report their error,
-    :mod:`mjeap.accuracy`; the scene as built keeps the arguments given).
+    :mod:`mjeap.simulation.accuracy`; the scene as built keeps the arguments given).
     """
 
     def __init__(self, actuator: Union[str, Actuator], representation: str = "hinge",
@@ -129,7 +129,7 @@ class Scene:
                  max_bend: float = DEFAULT_MAX_BEND, accuracy: Optional[float] = None):
         self.actuator = get_actuator(actuator)
         self.accuracy = None if accuracy is None else check_accuracy(accuracy)
-        #: set by :meth:`variant` for a model chosen by :mod:`mjeap.accuracy`: its timestep
+        #: set by :meth:`variant` for a model chosen by :mod:`mjeap.simulation.accuracy`: its timestep
         #: is bound by stability only (the accuracy target replaces the fixed rules)
         self.chosen_model = getattr(self, "chosen_model", False)
         self._arguments = dict(actuator=self.actuator, representation=representation, orientation=orientation,
@@ -294,7 +294,7 @@ class Scene:
     def variant(self, segments: int, timestep: float, integrator: str) -> "Scene":
         """This scene (actuator, orientation, payload, units, damping, gravity) as a model
         of ``segments`` hinges stepped at ``timestep`` (s) under ``integrator``, as chosen for
-        an accuracy target (:mod:`mjeap.accuracy`): only its stability limit binds the
+        an accuracy target (:mod:`mjeap.simulation.accuracy`): only its stability limit binds the
         timestep; above beta under 'discrete' the step's own damping h K exceeds the beam's,
         an error the target's estimate accounts for."""
         s = Scene.__new__(Scene)
@@ -425,7 +425,7 @@ class Scene:
 
     def native_model(self, drive):
         """This beam with ``drive`` (a :class:`mjeap.Drive` of this scene) compiled into the
-        model as MuJoCo elements (:mod:`mjeap.native`); built once per drive, parameters
+        model as MuJoCo elements (:mod:`mjeap.drives.native`); built once per drive, parameters
         and hinge parameters (a compile and a stability check, ~10 ms), then reused."""
         from .native_model import NativeModel
         key = (drive.name, repr(sorted(drive.params.items())), self.part.revision)

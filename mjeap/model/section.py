@@ -13,7 +13,7 @@ from typing import Optional, Sequence
 
 import numpy as np
 
-from .errors import ParameterError, check_positive
+from ..errors import ParameterError, check_positive
 
 
 @dataclass(frozen=True)

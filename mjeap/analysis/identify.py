@@ -19,7 +19,7 @@ from typing import Dict, Optional, Sequence, Tuple, Union
 import numpy as np
 from scipy import optimize, signal
 
-from .errors import ParameterError
+from ..errors import ParameterError
 
 #: fewest samples accepted by the fits
 MIN_SAMPLES = 20
@@ -59,7 +59,7 @@ def read_columns(path: Union[str, Path], columns: Sequence[str], min_samples: in
     """Read the named columns of a CSV with a header row. A header matches a requested name
     when it is equal or starts with it followed by ' (' (a unit), e.g. 'time (s)' for 'time'.
     The first column requested is the time base and is checked like :func:`check_series`."""
-    from .csvio import number, read_rows
+    from ..io.csvio import number, read_rows
     rows = read_rows(path, "data file")
     header = [h.strip() for h in rows[0]]
     idx = {}
@@ -109,7 +109,7 @@ class StepFit:
                 "pole_electrical": self.pole_electrical}
 
     def make_drive(self, scene):
-        from .drives import make_drive
+        from ..drives import make_drive
         return make_drive("rc-relaxation", scene, **self.drive_parameters())
 
 
@@ -187,7 +187,7 @@ def simulate_tip(scene, stiffness: float, damping: float, voltage, duration: flo
                  drive=None, drive_params: Optional[dict] = None) -> np.ndarray:
     """Tip deflection (m, clamp frame y) of ``scene`` with uniform hinge ``stiffness`` and
     ``damping`` driven by ``voltage`` for ``duration`` s, interpolated at ``times``."""
-    from .rollout import rollout
+    from ..simulation.rollout import rollout
     scene.set_hinge_parameters(stiffness=stiffness, damping=damping)
     r = rollout(scene, voltage, duration, drive=drive, drive_params=drive_params, progress=False,
                 sample_interval=max(scene.timestep, float(np.min(np.diff(times))) / 2) if len(times) > 1 else None)

@@ -1,0 +1,1 @@
+"""Analysis on simulations: frequency response, identification, calibration, the stability map."""

@@ -1,0 +1,1 @@
+"""Input and output: files that survive a stop (outputs), users' CSV (csvio), Rerun recordings (recording)."""
