@@ -180,7 +180,7 @@ def trot_voltages(frequency: float, amplitude: float = AMPLITUDE, bias: float = 
     out = {}
     for leg, (_, _, phase) in LEGS.items():
         for dof, lead in (("swing", 0.0), ("lift", 0.5 * np.pi)):
-            text = f"sine:{amplitude:g}V@{frequency:g}Hz,offset={0.5 * bias:g}V,phase={phase + lead:.9g}"
+            text = f"sine:{amplitude:g}V@{frequency:g}Hz,offset={0.5 * bias:g}V,phase={phase + lead:.17g}"
             out[f"{leg}_{dof}"] = SoftStart(text, ramp_cycles / frequency)
     return out
 
