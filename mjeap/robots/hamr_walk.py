@@ -87,6 +87,7 @@ PAPER_SPEED, PAPER_FREQUENCY = 0.5, 65.0      # m/s at Hz, seed 003
 PAPER_INCLINE = 22.0                          # deg, seed 003 ("inclines nearing 22 deg")
 FREQUENCIES = (5.0, 10.0, 20.0, 40.0, 65.0, 80.0, 100.0)
 FREQUENCY_RANGE = (1.0, 100.0)                # Hz
+RECORD_FREQUENCY = 10.0                       # Hz: the recorded run (at full amplitude it trots upright there)
 #: leg name -> (fore +1 / aft -1, side +1 left / -1 right, trot phase of its pair)
 LEGS = {"FL": (1, 1, 0.0), "FR": (1, -1, np.pi), "RL": (-1, 1, np.pi), "RR": (-1, -1, 0.0)}
 SETTLE = 0.1                    # s at least, and SETTLE_CYCLES cycles, before measuring
@@ -324,7 +325,7 @@ def segment_effect(segments: Sequence[int] = (2, SEGMENTS, 20), frequencies: Seq
     return out
 
 
-def max_incline(frequency: float = PAPER_FREQUENCY, amplitude: float = AMPLITUDE, mu: float = MU,
+def max_incline(frequency: float = RECORD_FREQUENCY, amplitude: float = AMPLITUDE, mu: float = MU,
                 segments: int = SEGMENTS, step: float = 4.0, top: float = 32.0) -> dict:
     """The steepest ground incline (deg, in ``step`` up to ``top``) on which the trot at
     ``frequency`` still climbs: forward speed along the slope > 0 with the body upright
@@ -402,7 +403,7 @@ def write_recording(path, system: System, run: dict) -> None:
                                 axis_x=x_axis(t)),
              rrb.TimeSeriesView(origin="/walk/clearance", name="foot clearance above the ground (m)",
                                 axis_y=y_axis(clearance), axis_x=x_axis(t)))
-    write_system_recording(path, run["result"], system, extra=extra, views=views)
+    write_system_recording(path, run["result"], system, extra=extra, views=views, actuator_views=False)
 
 
 def model_summary(system: System) -> dict:
@@ -431,13 +432,14 @@ def main(argv=None):
     ap.add_argument("--out", default="out/hamr_walk.rrd", type=arg_output(), help="recording (.rrd)")
     ap.add_argument("--frequencies", nargs="+", type=arg_number(*FREQUENCY_RANGE, "Hz"), default=list(FREQUENCIES),
                     help=f"trot frequencies (Hz, {FREQUENCY_RANGE[0]:g} to {FREQUENCY_RANGE[1]:g})")
-    ap.add_argument("--record-frequency", type=arg_number(*FREQUENCY_RANGE, "Hz"), default=PAPER_FREQUENCY,
+    ap.add_argument("--record-frequency", type=arg_number(*FREQUENCY_RANGE, "Hz"), default=RECORD_FREQUENCY,
                     help="the frequency of the recorded run (Hz)")
     ap.add_argument("--amplitude", type=arg_number(0.0, AMPLITUDE, "V", lo_open=True), default=AMPLITUDE,
                     help=f"drive amplitude about V_bias / 2 (V; {AMPLITUDE:g}: full, the signal swings 0..{BIAS:g} V)")
     ap.add_argument("--mu", type=arg_number(0.0, 10.0), default=MU, help="foot-ground friction coefficient")
     ap.add_argument("--segments", type=arg_integer(1, 40), default=SEGMENTS, help="segments per actuator")
-    ap.add_argument("--quick", action="store_true", help="skip the segment check and the incline search")
+    ap.add_argument("--quick", action="store_true",
+                    help="skip the segment check and the incline search (at --record-frequency)")
     a = parse_args(ap, argv)
     d = design()
     system = build(a.mu, a.segments, d=d)
@@ -465,7 +467,7 @@ def main(argv=None):
     out["wall_s_per_simulated_s"] = float(np.mean([r["wall_s_per_simulated_s"] for r in out["runs"]]))
     if not a.quick:
         out["segment_effect"] = segment_effect()
-        out["incline"] = max_incline(PAPER_FREQUENCY, a.amplitude, a.mu, a.segments)
+        out["incline"] = max_incline(a.record_frequency, a.amplitude, a.mu, a.segments)
     out["recording"] = a.out
     print(json.dumps(out, indent=1, default=float))
 
