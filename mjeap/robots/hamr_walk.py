@@ -2,56 +2,84 @@
 quadruped, four legs of two pzt-hamr-small actuators each (the legs of
 mjeap.robots.hamr_leg), trotting on a ground plane open loop at the paper's 200 V bias.
 
-    mjeap robot hamr-walk [--out out/hamr_walk.rrd] [--frequencies 5,10,20,40,65,80,100]
-        [--record-frequency 65] [--mu 0.7] [--segments 4] [--incline]
+    mjeap robot hamr-walk [--out out/hamr_walk.rrd] [--frequencies 5 10 20 40 65 80 100]
+        [--record-frequency 10] [--amplitude 100] [--mu 0.51] [--segments 4] [--quick]
 
 Prints JSON: per frequency the forward speed, the no-slip kinematic estimate, foot slip,
-body pitch and roll, penetration and wall time; the speed at 65 Hz beside the paper's
-0.5 m/s; with --incline the steepest incline climbed at 65 Hz. Writes a recording of the
---record-frequency run. Written against mjeap's public component API (attach, System,
-ContactParameters, add_transmission) and plain MjSpec.
+body roll and pitch, penetration and wall time; the speed at 65 Hz beside the paper's
+0.5 m/s; the segment check and the steepest incline climbed at --record-frequency (not with
+--quick). Writes a recording of the --record-frequency run. Written against mjeap's public
+component API (attach, System, ContactParameters, add_transmission) and plain MjSpec.
 
 Model (host in mm, mg, ms; gravity along -z; x forward, y left, z up):
-- Body: a free body (freejoint), BODY_LENGTH = 45.1 mm long (seed 003: "a 4.51 cm long,
-  1.43 g quadrupedal microrobot"); its width (BODY_WIDTH, 15 mm) and height (BODY_HEIGHT,
-  4 mm) are ASSUMED (HAMR photographs, not a cited number). The whole robot weighs
-  TOTAL_MASS = 1.43 g (seed 003): the body's own mass is what the eight actuators and the
-  four legs leave of it (a uniform box).
-- Legs: mjeap.robots.hamr_leg.add_leg, the single leg's design (hamr_leg.design(): joint
-  inertias that put the loaded actuators at the transmission resonances, 100 Hz swing and
-  80 Hz lift, zeta 0.05; transmissions T_swing = 13, T_lift = 12, seed 003 from its ref.
-  [51]; LEG_LENGTH 10 mm, ASSUMED), one per corner: hips at x = +-HIP_X (14 mm, ASSUMED),
-  y = +-BODY_WIDTH / 2, the rod outward along +-y, the foot FOOT_DROP = 6 mm (ASSUMED) below
-  its end on a massless shank (which leaves the foot's fore-aft and normal motion per joint
-  angle as the single leg's). The legs' mass radius is LEG_LENGTH (the single leg uses
-  2 mm, which would make the four legs heavier than the robot): each leg carries the single
-  leg's inertias with about 0.1 g.
+- Body: a free body (freejoint), BODY_LENGTH = 45.1 mm long, the whole robot TOTAL_MASS =
+  1.43 g (seed 003: "a 4.51 cm long, 1.43 g quadrupedal microrobot"); width 15 mm and height
+  4 mm ASSUMED; the body's own mass (a uniform box, 0.49 g) is what the eight actuators
+  (0.48 g) and the four legs (0.46 g) leave.
+- Legs: mjeap.robots.hamr_leg.add_leg with the single leg's design (hamr_leg.design():
+  joint inertias that put the loaded actuators at the transmission resonances, 100 Hz swing
+  and 80 Hz lift, zeta 0.05; T_swing = 13, T_lift = 12, seed 003 from its ref. [51];
+  LEG_LENGTH 10 mm, ASSUMED there), one per corner: hips at x = +-HIP_X (14 mm, ASSUMED),
+  y = +-7.5 mm (the body's sides), the rod outward along +-y, the foot FOOT_DROP = 11.35 mm
+  below its end on a massless shank (the foot's offset below its leg frame in N. Doshi's
+  HAMR-VI simulation model, HamrRBM.FOOT_POS, public Drake/MATLAB code; the shank leaves the
+  foot's fore-aft and normal motion per joint angle as the single leg's and adds a lateral
+  one, 11.35 mm per radian of lift). Mass radius LEG_LENGTH (the single leg's 2 mm would
+  make each leg weigh 1.8 g): each leg carries the single leg's inertias with 0.12 g.
 - Actuators: eight pzt-hamr-small (piezo-bimorph drive, bias 200 V), clamped on the body
-  (mount sites on it, so the clamps ride with it), lying along x in the body's horizontal
-  plane (their bending plane; gravity along their hinge axes), the front legs' pointing
-  forward, the rear legs' backward; ``contact=False``: only the feet touch the ground.
-  ``segments`` per actuator: SEGMENTS = 4 (the measured effect on the foot amplitude is in
-  :func:`segment_effect` and the README snippet).
-- Feet: spheres of FOOT_RADIUS = 0.5 mm (ASSUMED) touching a ground plane, Coulomb
-  friction mu = MU = 0.7 (ASSUMED: paper or card-stock ground, a parameter), MuJoCo soft
-  contact set by mjeap.system.ContactParameters (time constant 2 timesteps, critically
-  damped, elliptic cone, impratio 10 against creep); solimp width CONTACT_WIDTH_FRACTION x
-  FOOT_RADIUS is the contact tolerance for the penetration check.
+  (mount sites on it: the clamps ride with it), along x in the body's horizontal plane (their
+  bending plane; gravity along their hinge axes), the front legs' pointing forward, the
+  rear legs' backward; ``contact=False``: only the feet touch the ground. SEGMENTS = 4 per
+  actuator: against 20, the single leg's foot gain moves by -0.05 % (swing) and -0.1 %
+  (lift) at 20 Hz, -0.4 % and -1.7 % at 65 Hz (2 segments: -1.2 % and -3.6 % at 65 Hz;
+  :func:`segment_effect`); the timestep (10.4 us) is set by the first mode either way.
+- Feet: spheres of FOOT_RADIUS = 0.5 mm (ASSUMED) on a ground plane, Coulomb friction
+  MU = 0.51 (the value of Doshi's HAMR trot simulations; a parameter), MuJoCo soft contact
+  from mjeap.system.ContactParameters (time constant 2 timesteps, critically damped,
+  elliptic cone, impratio 10 against creep); the solimp width, 0.1 x FOOT_RADIUS = 50 um,
+  is the contact tolerance of the penetration check.
 
-Gait (trot): per actuator V = V_bias/2 + V_bias/2 sin(omega t + phi) (signal 0..200 V at
-a 200 V bias, full amplitude); the diagonal pairs (front-left + rear-right, front-right +
-rear-left) in phase, the two pairs 180 degrees apart, each lift 90 degrees ahead of its swing
-(the foot ellipse of seed 003's ref. [50]: with foot x ~ sin, z ~ cos the foot is down
-while it moves backward). Open loop: near the transmission resonances the feet lag their
-drive (the single leg's sweeps), which is what the paper's closed loop corrects.
+Gait (trot): per actuator V = V_bias/2 + a sin(omega t + phi), a = AMPLITUDE = 100 V by
+default (full: the signal swings 0..200 V); the diagonal pairs (front-left + rear-right,
+front-right + rear-left) in phase, the pairs 180 degrees apart, each lift 90 degrees ahead of
+its swing (the foot ellipse of seed 003's ref. [50]: with foot x ~ sin and z ~ cos the foot
+is down while it moves backward). The amplitude is ramped over the first 2 cycles
+(:class:`SoftStart`, as Doshi's simulations ramp theirs): a lift 90 degrees ahead would
+otherwise start with a 100 V step. Open loop: near the transmission resonances each foot
+lags its drive (the single leg's sweeps), which is what the paper's phase loop corrects.
 
-Read-outs (SI): forward speed (body displacement along the ground's x over whole cycles
-after SETTLE, divided by their duration); body pitch and roll (deg, relative to the
-ground); foot slip (fraction of the samples with a foot in contact where its tangential
-speed exceeds SLIDE_FRACTION of its stance speed relative to the body); penetration (m);
-the no-slip kinematic estimate (the mean over time of the stance feet's backward speed
-relative to the body, from the foot path in the body frame: what the body would move if
-no stance foot slid), with the stance stroke, duty factor and stroke x f / duty.
+Read-outs (SI): forward speed (the body's displacement along the ground's x over whole
+cycles after the ramp and 2 more cycles, at least 0.1 s, divided by their duration); roll
+and pitch relative to the ground; stance: a foot within STANCE_GAP = 10 um of the ground
+(MuJoCo's contact list flickers at zero depth); foot slip: the fraction of stance samples
+whose tangential foot speed exceeds SLIDE_FRACTION = 10 % of the mean stance speed relative
+to the body; penetration; the no-slip kinematic estimate: the mean over time of the stance
+feet's backward speed relative to the body (foot path in the body frame), i.e. what the
+body would move if no stance foot slid; also the stance stroke, duty factor, stroke x f /
+duty.
+
+Findings (4 segments, mu 0.51; wall time 3.5-7 s per simulated second on 2 shared cores):
+- Full amplitude (the paper's drive): the feet move T x delta(200 V) = 3.5 mm (swing) and
+  3.2 mm (lift) quasi-statically on a 10 mm leg, 6.1 and 9.4 mm at 65 Hz (dynamic gains 1.7
+  and 2.9). The robot trots upright only at 5-10 Hz (0.079 and 0.092 m/s, roll and pitch
+  8-13 deg, the body rocking on its diagonal support and hopping on its legs' lift
+  compliance: k_foot = m_foot (2 pi 80 Hz)^2 = 9 N/m, the body bounces at 18 Hz on two
+  feet, 25 Hz on four, damped to zeta ~0.01); 75-85 % of the stance samples slide and the
+  speed is 0-20 % off the no-slip estimate depending on details (mu 0.50 or 0.52, 3 or 5
+  segments: the motion is chaotic). At 20 Hz it rocks to 29 deg and goes backward
+  (-0.06 m/s); at 40, 65 and 80 Hz it rolls over (at 65 Hz the body jumps to 81 mm), at
+  100 Hz it rolls past 50 deg: no speed at 65 Hz to set beside the paper's 0.5 m/s.
+  Transmission damping is not the cause alone: zeta 0.15 or 0.3 still rolls over at 65 Hz.
+- Reduced amplitude: at 30 V (feet 1.0 mm quasi-static) the trot is upright at 5-65 Hz;
+  20 Hz: 0.096 m/s, the no-slip estimate within 2 % (tested), roll and pitch below 3 deg;
+  65 Hz: 0.185 m/s (0.37 x the paper), a bounding gait (the body 3-6 mm above its standing
+  height, the feet striking the ground briefly: 1 % of the samples). At 20 V the speed rises with frequency to 0.136 m/s at 40 Hz
+  (no-slip estimate within 1 %), then falls: 0.076 m/s at 65 Hz, backward at 80 Hz
+  (-0.30 m/s), where the lift (80 Hz) lags its drive by 90 deg and the swing (100 Hz) by
+  12 deg, so the feet touch down while swinging forward; the paper's phase loop exists
+  for this.
+- Incline (the ground tilted, gravity along -z): full amplitude at 10 Hz climbs 4 deg, not
+  8; 30 V at 20 Hz climbs 8, not 12 (the paper: nearly 22 deg).
 """
 from __future__ import annotations
 
