@@ -313,9 +313,9 @@ def walk_metrics(run: dict) -> dict:
     return {
         "frequency_hz": f, "amplitude_v": run["amplitude"],
         "speed_m_s": speed, "lateral_drift_m_s": lateral,
-        "kinematic_speed_m_s": float(np.nanmean(v_est)) if any_c.any() else float("nan"),
+        "kinematic_speed_m_s": float(np.nanmean(v_est)) if any_c.any() else None,    # None: no foot ever down
         "stance_stroke_m": stroke, "duty_factor": duty,
-        "stroke_f_over_duty_m_s": stroke * f / duty if duty > 0 else float("nan"),
+        "stroke_f_over_duty_m_s": stroke * f / duty if duty > 0 else None,
         "time_with_a_foot_down": float(any_c.mean()),
         "slip_fraction": float(slides.sum() / max(c.sum(), 1)), "slide_threshold_m_s": threshold,
         "max_abs_roll_deg": float(np.abs(rp[:, 0]).max()), "max_abs_pitch_deg": float(np.abs(rp[:, 1]).max()),
@@ -480,18 +480,19 @@ def main(argv=None):
         out["runs"].append(m)
         if f == a.record_frequency and a.out:
             write_recording(a.out, system, run)
-        print(f"{f:g} Hz: {m['speed_m_s']:.4g} m/s (no-slip {m['kinematic_speed_m_s']:.4g}), slip "
+        print(f"{f:g} Hz: {m['speed_m_s']:.4g} m/s (no-slip {m['kinematic_speed_m_s'] or float('nan'):.4g}), slip "
               f"{m['slip_fraction']:.2f}, roll/pitch {m['max_abs_roll_deg']:.1f}/{m['max_abs_pitch_deg']:.1f} deg, "
               f"{m['wall_s_per_simulated_s']:.1f} s wall per s", file=sys.stderr)
     at = {r["frequency_hz"]: r for r in out["runs"]}
     if PAPER_FREQUENCY in at:
-        v = at[PAPER_FREQUENCY]["speed_m_s"]
-        out["speed_at_65hz_m_s"], out["paper_speed_m_s"] = v, PAPER_SPEED
-        out["speed_over_paper"] = v / PAPER_SPEED
+        v, up = at[PAPER_FREQUENCY]["speed_m_s"], at[PAPER_FREQUENCY]["upright"]
+        out["speed_at_65hz_m_s"], out["paper_speed_m_s"], out["upright_at_65hz"] = v, PAPER_SPEED, up
+        # a robot that rolled over has no speed to compare
+        out["speed_over_paper"] = v / PAPER_SPEED if up else None
     low = at[min(at)]
+    k = low["kinematic_speed_m_s"]
     out["kinematic_check"] = {"frequency_hz": low["frequency_hz"], "speed_m_s": low["speed_m_s"],
-                              "no_slip_estimate_m_s": low["kinematic_speed_m_s"],
-                              "relative_error": low["speed_m_s"] / low["kinematic_speed_m_s"] - 1.0}
+                              "no_slip_estimate_m_s": k, "relative_error": None if not k else low["speed_m_s"] / k - 1.0}
     out["wall_s_per_simulated_s"] = float(np.mean([r["wall_s_per_simulated_s"] for r in out["runs"]]))
     if not a.quick:
         out["segment_effect"] = segment_effect()
