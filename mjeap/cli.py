@@ -340,7 +340,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="without --accuracy: estimate this model's error with a coarser companion run")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_rollout)
-    p = sub.add_parser("robot", help="run a robot's experiment (mjeap.robots): gripper, hamr-leg, robobee-wing",
+    p = sub.add_parser("robot",
+                       help="run a robot's experiment (mjeap.robots): gripper, hamr-leg, hamr-walk, robobee-wing",
                        description="Run a registered robot's experiment; its options follow the name "
                                    "(mjeap robot NAME --help).")
     p.add_argument("name", help="a registered robot (mjeap.robots.names())")

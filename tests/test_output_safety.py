@@ -42,7 +42,7 @@ rollout(Scene('pedot-micro'), None, 500.0, controller=Ready(), engine='loop', sa
 """,
     "system": """
 import mujoco
-from mjeap.system import System, attach
+from mjeap.simulation.system import System, attach
 spec = mujoco.MjSpec.from_string('<mujoco><option gravity="0 0 -0.00980665"/><worldbody><site name="m"/>'
                                  '</worldbody></mujoco>')
 s = System(spec, [attach(spec, 'pedot-micro', site='m', prefix='a', contact=False)])

@@ -1,7 +1,7 @@
 """The robot registry (mjeap.robots): every robot builds from its name alone, its named
 read-outs answer in SI on the built system, and ``mjeap robot`` reaches each experiment's
 command line. The physics of each robot is tested in its own file (test_gripper,
-test_hamr_leg_linkage, test_robobee_wing)."""
+test_hamr_leg_linkage, test_hamr_walk, test_robobee_wing)."""
 import numpy as np
 import pytest
 
@@ -11,13 +11,13 @@ from mjeap.errors import UnknownNameError
 from mjeap.simulation.system import System
 
 
-def test_the_registry_holds_the_three_robots_with_tags():
-    assert robots.names() == ["gripper", "hamr-leg", "robobee-wing"]
-    assert robots.names("piezo") == ["hamr-leg", "robobee-wing"]
+def test_the_registry_holds_the_four_robots_with_tags():
+    assert robots.names() == ["gripper", "hamr-leg", "hamr-walk", "robobee-wing"]
+    assert robots.names("piezo") == ["hamr-leg", "hamr-walk", "robobee-wing"]
     assert all(robots.get(n).summary for n in robots.names())
 
 
-@pytest.mark.parametrize("name", ["gripper", "robobee-wing"])
+@pytest.mark.parametrize("name", ["gripper", "hamr-walk", "robobee-wing"])
 def test_a_robot_builds_from_its_name_and_reads_out_at_rest(name):
     system = robots.load(name)
     assert isinstance(system, System)
@@ -35,7 +35,7 @@ def test_an_unknown_robot_is_named_with_the_known_ones(capsys):
     with pytest.raises(UnknownNameError, match="did you mean 'hamr-leg'"):
         robots.get("hamr_leg")
     assert main(["robot", "hamr_leg"]) == 2
-    assert "gripper, hamr-leg, robobee-wing" in capsys.readouterr().err
+    assert "gripper, hamr-leg, hamr-walk, robobee-wing" in capsys.readouterr().err
 
 
 def test_mjeap_robot_passes_its_options_to_the_experiment(capsys):

@@ -326,20 +326,22 @@ def _geom_archetype(rr, model, g: int, length: float, color):
     return None
 
 
-def write_system_recording(path, result, system, extra=None, views=()) -> Path:
+def write_system_recording(path, result, system, extra=None, views=(), actuator_views: bool = True) -> Path:
     """Write a :class:`mjeap.system.SystemResult` to ``path`` (.rrd): every beam's
     centreline and tip (world frame, m), every other body's geoms (boxes, spheres,
     ellipsoids, capsules, cylinders) moving with their bodies, and per actuator its voltage
     and tip curvature; the net contact force on every body that touches something.
     ``extra(rec)`` may log more entities to the open ``rerun.RecordingStream``; ``views``
-    (rerun blueprint views) are placed first in the plots' column for them. Written whole
+    (rerun blueprint views) are placed first in the plots' column for them.
+    ``actuator_views=False`` logs each actuator's plots but leaves their views out of the
+    layout (a system of many actuators: the column keeps ``views`` readable). Written whole
     (:func:`mjeap.outputs.replacing`)."""
     with replacing(path, "rrd") as tmp:
-        _write_system_recording(tmp, result, system, extra, views)
+        _write_system_recording(tmp, result, system, extra, views, actuator_views)
     return Path(path)
 
 
-def _write_system_recording(path, result, system, extra, views) -> None:
+def _write_system_recording(path, result, system, extra, views, actuator_views=True) -> None:
     import rerun as rr
     import rerun.blueprint as rrb
     m, L = system.model, system.units.length
@@ -348,7 +350,7 @@ def _write_system_recording(path, result, system, extra, views) -> None:
     t = result.time
     groups = [rrb.Vertical(_ts(f"/plots/{n}/tip_curvature", f"{n}: tip curvature (1/m)", res[n].tip_curvature, time=t),
                            _ts(f"/plots/{n}/voltage", f"{n}: voltage (V)", res[n].voltage, time=t), name=n)
-              for n in names]
+              for n in names] if actuator_views else []
     touched = [b for b in range(m.nbody) if len(result.time) and np.abs(result.contact_force[:, b]).max() > 0]
     if touched:
         groups.append(_ts("/plots/contact", "contact force (N)",

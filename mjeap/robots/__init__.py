@@ -3,7 +3,7 @@ named robots, each with its builder (returns a :class:`~mjeap.system.System`), i
 read-outs (SI) and its experiment's command line, tagged by what it shows.
 
     from mjeap import robots
-    robots.names()                     # ['gripper', 'hamr-leg', 'robobee-wing']
+    robots.names()                     # ['gripper', 'hamr-leg', 'hamr-walk', 'robobee-wing']
     system = robots.load("robobee-wing", bias=200.0)
     robots.get("robobee-wing").readouts["stroke_angle"](system)     # rad
 
@@ -20,7 +20,7 @@ from ..errors import UnknownNameError
 from .registry import _REGISTRY, Robot, register, summary
 
 #: the modules that register the robots, imported on first use (they import SciPy and MjSpec code)
-_MODULES = ("gripper", "hamr_leg", "robobee_wing")
+_MODULES = ("gripper", "hamr_leg", "hamr_walk", "robobee_wing")
 
 __all__ = ["Robot", "register", "names", "get", "load", "summary"]
 

@@ -59,7 +59,7 @@ from ..model.analytical import DadrasModel
 from ..cli import arg_number, arg_output, parse_args, run_script
 from ..errors import ParameterError, check_range
 from ..sweep import stop_workers, worker_signals
-from . import Robot, register, summary
+from .registry import Robot, register, summary
 from ..simulation.system import ContactParameters, System, attach
 
 BEAD_RADIUS = 0.75e-3         # m

@@ -47,13 +47,14 @@ import mujoco
 import numpy as np
 from scipy import optimize
 
-from ..controllers.hamr_leg import (LIFT, SWING, LegPhaseController, cycles_to_within, free_estimator, leg_scene, phase_errors_per_cycle, phase_loop_gains)
-from .. import Scene
-from ..cli import arg_integer, arg_output, parse_args, run_script
-from ..errors import check_integer
 from ..analysis.frequency import phasor
-from . import Robot, register, summary
+from ..cli import arg_integer, arg_output, parse_args, run_script
+from ..controllers.hamr_leg import (LIFT, SWING, LegPhaseController, cycles_to_within, free_estimator, leg_scene,
+                                    phase_errors_per_cycle, phase_loop_gains)
+from ..errors import check_integer
+from ..simulation.scene import DEFAULT_SEGMENTS, Scene
 from ..simulation.system import System, add_transmission, attach
+from .registry import Robot, register, summary
 
 ACTUATOR = "pzt-hamr-small"
 LEG_LENGTH = 10e-3            # m, assumed (see the module text)
@@ -83,53 +84,82 @@ def design() -> dict:
     return out
 
 
-def build(d: Optional[dict] = None, bias: float = BIAS) -> System:
-    """The leg system (host in mm, mg, ms) from :func:`design` (computed when ``d`` is None)."""
+def build(d: Optional[dict] = None, bias: float = BIAS, segments: int = DEFAULT_SEGMENTS) -> System:
+    """The leg system (host in mm, mg, ms) from :func:`design` (computed when ``d`` is None);
+    ``segments`` per actuator (:func:`mjeap.system.attach`)."""
     d = design() if d is None else d
     spec = mujoco.MjSpec.from_string('<mujoco><option gravity="0 0 -9.80665e-3"/><worldbody/></mujoco>')
     wb = spec.worldbody
     acts = {}
     for k, (name, z) in enumerate((("swing", 0.0), ("lift", -4.0))):
         site = wb.add_site(name=f"{name}_mount", pos=[-14.0, -3.0 - 3.0 * k, z])
-        acts[name] = attach(spec, ACTUATOR, site=site.name, prefix=name, contact=False, drive_params={"bias": bias})
+        acts[name] = attach(spec, ACTUATOR, site=site.name, prefix=name, contact=False, drive_params={"bias": bias},
+                            segments=segments)
+    add_leg(spec, wb, acts, d)
+    return System(spec, [acts["swing"], acts["lift"]])
+
+
+def add_leg(spec: mujoco.MjSpec, parent, acts: dict, d: dict, *, prefix: str = "", pos=(0.0, 0.0, 0.0),
+            side: float = 1.0, mass_radius: float = 2.0, foot_drop: float = 0.0, foot_radius: float = 0.5,
+            foot_contact: bool = False):
+    """One leg on ``parent`` (a body of ``spec``) at its hip ``pos`` (internal units), driven
+    by ``acts`` ({'swing': ..., 'lift': ...}, attached actuators) through their
+    transmissions, with the joint inertias and damping of ``d`` (:func:`design`). Names are
+    ``prefix`` + swing_stage, swing, leg, lift, lift_lever, foot (site and geom).
+
+    ``side``: +1, the leg along +y (as :func:`build`), or -1, mirrored along -y; the
+    transmission signs follow, so that on either side a positive tip deflection moves the
+    foot +x (swing) and +z (lift). ``mass_radius`` (internal length): the radius at which
+    the stage's and the lever's masses sit (their masses are inertia / radius^2, so a larger
+    radius carries the same inertia with less mass). ``foot_drop``: the foot hangs this far
+    below the end of the leg rod on a massless shank, which leaves the foot's fore-aft (swing)
+    and normal (lift) motion per joint angle unchanged (adds a lateral one of foot_drop per
+    radian of lift). ``foot_contact``: the foot's sphere (``foot_radius``) touches geoms
+    with conaffinity 1 (condim 3); it never touches another foot. Returns the leg body."""
     u = acts["swing"].twin.units
     to_I = u.mass * u.length**2
     ell = LEG_LENGTH / u.length
+    y = side * ell
     I_s, I_l = (d[n]["joint_inertia_kg_m2"] / to_I for n in ("swing", "lift"))
     I_leg = LEG_SHARE * min(I_s, I_l)
     m_leg = 3 * I_leg / ell**2                                 # a thin rod about its end
-    r = 2.0                                                    # mm, the stage's and the lever's mass radius
-    stage = wb.add_body(name="swing_stage")
-    stage.add_joint(name="swing", type=mujoco.mjtJoint.mjJNT_HINGE, axis=AXES["swing"],
+    r = mass_radius                                            # the stage's and the lever's mass radius
+    stage = parent.add_body(name=f"{prefix}swing_stage", pos=list(pos))
+    stage.add_joint(name=f"{prefix}swing", type=mujoco.mjtJoint.mjJNT_HINGE, axis=AXES["swing"],
                     damping=d["swing"]["joint_damping_N_m_s"] / (to_I / u.time))
     # the stage turns about z only: a disc's inertia (its x and y values meet no joint)
-    stage.add_geom(name="stage", type=mujoco.mjtGeom.mjGEOM_CYLINDER, size=[1.0, 0.2, 0], mass=0,
+    stage.add_geom(name=f"{prefix}stage", type=mujoco.mjtGeom.mjGEOM_CYLINDER, size=[1.0, 0.2, 0], mass=0,
                    rgba=[0.6, 0.6, 0.65, 1], contype=0, conaffinity=0)
     stage.mass, stage.inertia = 2 * (I_s - I_leg) / r**2, [(I_s - I_leg) / 2, (I_s - I_leg) / 2, I_s - I_leg]
     stage.explicitinertial = True
-    leg = stage.add_body(name="leg")
-    leg.add_joint(name="lift", type=mujoco.mjtJoint.mjJNT_HINGE, axis=AXES["lift"],
+    leg = stage.add_body(name=f"{prefix}leg")
+    leg.add_joint(name=f"{prefix}lift", type=mujoco.mjtJoint.mjJNT_HINGE, axis=AXES["lift"],
                   damping=d["lift"]["joint_damping_N_m_s"] / (to_I / u.time))
-    leg.add_geom(name="leg", type=mujoco.mjtGeom.mjGEOM_CAPSULE, fromto=[0, 0, 0, 0, ell, 0], size=[0.25, 0, 0],
+    leg.add_geom(name=f"{prefix}leg", type=mujoco.mjtGeom.mjGEOM_CAPSULE, fromto=[0, 0, 0, 0, y, 0], size=[0.25, 0, 0],
                  mass=0, rgba=[0.85, 0.65, 0.3, 1], contype=0, conaffinity=0)
     # a thin rod's inertia, stated (a capsule's caps would add 1.7 % about the hip)
-    leg.mass, leg.ipos, leg.explicitinertial = m_leg, [0, ell / 2, 0], True
+    leg.mass, leg.ipos, leg.explicitinertial = m_leg, [0, y / 2, 0], True
     leg.inertia = [m_leg * ell**2 / 12, 1e-6 * m_leg * ell**2, m_leg * ell**2 / 12]
     # the lift lever: a rod along z centred on the lift axis, inertia about x (and y, which
     # no joint sees), none about z, so the swing does not see it
-    lever = leg.add_body(name="lift_lever")
-    lever.add_geom(name="lever", type=mujoco.mjtGeom.mjGEOM_CAPSULE, fromto=[0, 0, 1.5, 0, 0, -1.5], size=[0.2, 0, 0],
-                   mass=0, rgba=[0.6, 0.6, 0.65, 1], contype=0, conaffinity=0)
+    lever = leg.add_body(name=f"{prefix}lift_lever")
+    lever.add_geom(name=f"{prefix}lever", type=mujoco.mjtGeom.mjGEOM_CAPSULE, fromto=[0, 0, 1.5, 0, 0, -1.5],
+                   size=[0.2, 0, 0], mass=0, rgba=[0.6, 0.6, 0.65, 1], contype=0, conaffinity=0)
     lever.mass, lever.inertia = 3 * (I_l - I_leg) / r**2, [I_l - I_leg, I_l - I_leg, 1e-6 * (I_l - I_leg)]
     lever.explicitinertial = True
-    leg.add_site(name="foot", pos=[0, ell, 0])
-    leg.add_geom(name="foot", type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[0.5, 0, 0], pos=[0, ell, 0], mass=0,
-                 rgba=[0.9, 0.3, 0.2, 1], contype=0, conaffinity=0)
+    foot = [0, y, -foot_drop]
+    if foot_drop:
+        leg.add_geom(name=f"{prefix}shank", type=mujoco.mjtGeom.mjGEOM_CAPSULE, fromto=[0, y, 0, *foot],
+                     size=[0.2, 0, 0], mass=0, rgba=[0.85, 0.65, 0.3, 1], contype=0, conaffinity=0)
+    leg.add_site(name=f"{prefix}foot", pos=foot)
+    leg.add_geom(name=f"{prefix}foot", type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[foot_radius, 0, 0], pos=foot, mass=0,
+                 rgba=[0.9, 0.3, 0.2, 1], contype=int(foot_contact), conaffinity=0, condim=3)
     # transmissions: joint angle = sign x T d / LEG_LENGTH, the foot moving +T d along x / z
-    sign = {"swing": -1.0, "lift": 1.0}     # about z a +y leg moves its foot -x; about x, +z
+    # (about z a +y leg moves its foot -x; about x, +z; a -y leg the other way)
+    sign = {"swing": -side, "lift": side}
     for name, tr in DOFS.items():
-        add_transmission(spec, acts[name], name, sign[name] * tr.ratio / LEG_LENGTH)
-    return System(spec, [acts["swing"], acts["lift"]])
+        add_transmission(spec, acts[name], f"{prefix}{name}", sign[name] * tr.ratio / LEG_LENGTH)
+    return leg
 
 
 def foot(system: System) -> np.ndarray:

@@ -38,7 +38,7 @@ import numpy as np
 
 from ..controllers.self_sensing import calibrate_on_free_actuator
 from ..cli import arg_output, parse_args, run_script
-from . import Robot, register, summary
+from .registry import Robot, register, summary
 from ..simulation.system import System, add_transmission, attach
 
 T_EFF = 4000.0                                  # rad/m, seed 003 section 6.1

@@ -1,0 +1,511 @@
+"""HAMR-VI walks (issue 25; seed 003, section 6.2): a free-floating 1.43 g, 4.51 cm
+quadruped, four legs of two pzt-hamr-small actuators each (the legs of
+mjeap.robots.hamr_leg), trotting on a ground plane open loop at the paper's 200 V bias.
+
+    mjeap robot hamr-walk [--out out/hamr_walk.rrd] [--frequencies 5 10 20 40 65 80 100]
+        [--record-frequency 10] [--amplitude 100] [--mu 0.51] [--segments 4] [--quick]
+
+Prints JSON: per frequency the forward speed, the no-slip kinematic estimate, foot slip,
+body roll and pitch, penetration and wall time; the speed at 65 Hz beside the paper's
+0.5 m/s; the segment check and the steepest incline climbed at --record-frequency (not with
+--quick). Writes a recording of the --record-frequency run. Written against mjeap's public
+component API (attach, System, ContactParameters, add_transmission) and plain MjSpec.
+
+Model (host in mm, mg, ms; gravity along -z; x forward, y left, z up):
+- Body: a free body (freejoint), BODY_LENGTH = 45.1 mm long, the whole robot TOTAL_MASS =
+  1.43 g (seed 003: "a 4.51 cm long, 1.43 g quadrupedal microrobot"); width 15 mm and height
+  4 mm ASSUMED; the body's own mass (a uniform box, 0.49 g) is what the eight actuators
+  (0.48 g) and the four legs (0.46 g) leave.
+- Legs: mjeap.robots.hamr_leg.add_leg with the single leg's design (hamr_leg.design():
+  joint inertias that put the loaded actuators at the transmission resonances, 100 Hz swing
+  and 80 Hz lift, zeta 0.05; T_swing = 13, T_lift = 12, seed 003 from its ref. [51];
+  LEG_LENGTH 10 mm, ASSUMED there), one per corner: hips at x = +-HIP_X (14 mm, ASSUMED),
+  y = +-7.5 mm (the body's sides), the rod outward along +-y, the foot FOOT_DROP = 11.35 mm
+  below its end on a massless shank (the foot's offset below its leg frame in N. Doshi's
+  HAMR-VI simulation model, HamrRBM.FOOT_POS, public Drake/MATLAB code; the shank leaves the
+  foot's fore-aft and normal motion per joint angle as the single leg's and adds a lateral
+  one, 11.35 mm per radian of lift). Mass radius LEG_LENGTH (the single leg's 2 mm would
+  make each leg weigh 1.8 g): each leg carries the single leg's inertias with 0.12 g.
+- Actuators: eight pzt-hamr-small (piezo-bimorph drive, bias 200 V), clamped on the body
+  (mount sites on it: the clamps ride with it), along x in the body's horizontal plane (their
+  bending plane; gravity along their hinge axes), the front legs' pointing forward, the
+  rear legs' backward; ``contact=False``: only the feet touch the ground. SEGMENTS = 4 per
+  actuator: against 20, the single leg's foot gain moves by -0.05 % (swing) and -0.1 %
+  (lift) at 20 Hz, -0.4 % and -1.7 % at 65 Hz (2 segments: -1.2 % and -3.6 % at 65 Hz;
+  :func:`segment_effect`); the timestep (10.4 us) is set by the first mode either way.
+- Feet: spheres of FOOT_RADIUS = 0.5 mm (ASSUMED) on a ground plane, Coulomb friction
+  MU = 0.51 (the value of Doshi's HAMR trot simulations; a parameter), MuJoCo soft contact
+  from mjeap.simulation.system.ContactParameters (time constant 2 timesteps, critically damped,
+  elliptic cone, impratio 10 against creep); the solimp width, 0.1 x FOOT_RADIUS = 50 um,
+  is the contact tolerance of the penetration check.
+
+Gait (trot): per actuator V = V_bias/2 + a sin(omega t + phi), a = AMPLITUDE = 100 V by
+default (full: the signal swings 0..200 V); the diagonal pairs (front-left + rear-right,
+front-right + rear-left) in phase, the pairs 180 degrees apart, each lift 90 degrees ahead of
+its swing (the foot ellipse of seed 003's ref. [50]: with foot x ~ sin and z ~ cos the foot
+is down while it moves backward). The amplitude is ramped over the first 2 cycles
+(:class:`SoftStart`, as Doshi's simulations ramp theirs): a lift 90 degrees ahead would
+otherwise start with a 100 V step. Open loop: near the transmission resonances each foot
+lags its drive (the single leg's sweeps), which is what the paper's phase loop corrects.
+
+Read-outs (SI): forward speed (the body's displacement along the ground's x over whole
+cycles after the ramp and 2 more cycles, at least 0.1 s, divided by their duration); roll
+and pitch relative to the ground; stance: a foot within STANCE_GAP = 10 um of the ground
+(MuJoCo's contact list flickers at zero depth); foot slip: the fraction of stance samples
+whose tangential foot speed exceeds SLIDE_FRACTION = 10 % of the mean stance speed relative
+to the body; penetration; the no-slip kinematic estimate: the mean over time of the stance
+feet's backward speed relative to the body (foot path in the body frame), i.e. what the
+body would move if no stance foot slid; also the stance stroke, duty factor, stroke x f /
+duty.
+
+Findings (4 segments, mu 0.51; wall time 3.5-7 s per simulated second on 2 shared cores):
+- Full amplitude (the paper's drive): the feet move T x delta(200 V) = 3.5 mm (swing) and
+  3.2 mm (lift) quasi-statically on a 10 mm leg, 6.1 and 9.4 mm at 65 Hz (dynamic gains 1.7
+  and 2.9). The robot trots upright only at 5-10 Hz (0.079 and 0.092 m/s, roll and pitch
+  8-13 deg, the body rocking on its diagonal support and hopping on its legs' lift
+  compliance: k_foot = m_foot (2 pi 80 Hz)^2 = 9 N/m, the body bounces at 18 Hz on two
+  feet, 25 Hz on four, damped to zeta ~0.01); 75-85 % of the stance samples slide and the
+  speed is 0-20 % off the no-slip estimate depending on details (mu 0.50 or 0.52, 3 or 5
+  segments: the motion is chaotic). At 20 Hz it rocks to 29 deg and goes backward
+  (-0.06 m/s); at 40, 65 and 80 Hz it rolls over (at 65 Hz the body jumps to 81 mm), at
+  100 Hz it rolls past 50 deg: no speed at 65 Hz to set beside the paper's 0.5 m/s.
+  Transmission damping is not the cause alone: zeta 0.15 or 0.3 still rolls over at 65 Hz.
+- Reduced amplitude: at 30 V (feet 1.0 mm quasi-static) the trot is upright at 5-65 Hz;
+  20 Hz: 0.096 m/s, the no-slip estimate within 2 % (tested), roll and pitch below 3 deg;
+  65 Hz: 0.185 m/s (0.37 x the paper), a bounding gait (the body 3-6 mm above its standing
+  height, the feet striking the ground briefly: 1 % of the samples). At 20 V the speed rises with frequency to 0.136 m/s at 40 Hz
+  (no-slip estimate within 1 %), then falls: 0.076 m/s at 65 Hz, backward at 80 Hz
+  (-0.30 m/s), where the lift (80 Hz) lags its drive by 90 deg and the swing (100 Hz) by
+  12 deg, so the feet touch down while swinging forward; the paper's phase loop exists
+  for this.
+- Incline (the ground tilted, gravity along -z): full amplitude at 10 Hz climbs 4 deg, not
+  8; 30 V at 20 Hz climbs 8, not 12 (the paper: nearly 22 deg).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+from typing import Optional, Sequence
+
+import mujoco
+import numpy as np
+
+from ..cli import arg_integer, arg_number, arg_output, parse_args, run_script
+from ..drives.waveforms import parse_waveform
+from ..errors import ParameterError, check_integer, check_range
+from ..simulation.system import ContactParameters, System, attach
+from . import hamr_leg
+from .hamr_leg import ACTUATOR, LEG_LENGTH, add_leg, design
+from .registry import Robot, register, summary
+
+TOTAL_MASS = 1.43e-3            # kg, seed 003
+BODY_LENGTH = 45.1e-3           # m, seed 003
+BODY_WIDTH = 15e-3              # m, assumed
+BODY_HEIGHT = 4e-3              # m, assumed
+HIP_X = 14e-3                   # m, assumed (hips 28 mm apart fore-aft)
+FOOT_DROP = 11.35e-3            # m, the foot below its leg frame in Doshi's HAMR model (see the module text)
+FOOT_RADIUS = 0.5e-3            # m, assumed
+MU = 0.51                       # sliding friction, as Doshi's HAMR trot simulations (see the module text)
+CONTACT_WIDTH_FRACTION = 0.1    # solimp width as a fraction of FOOT_RADIUS: the penetration tolerance
+IMPRATIO = 10.0
+BIAS = 200.0                    # V, HAMR's drive bias (the brief's "paper's 200 V")
+AMPLITUDE = 0.5 * BIAS          # V, full amplitude: the signal swings 0..V_bias
+SEGMENTS = 4
+PAPER_SPEED, PAPER_FREQUENCY = 0.5, 65.0      # m/s at Hz, seed 003
+PAPER_INCLINE = 22.0                          # deg, seed 003 ("inclines nearing 22 deg")
+FREQUENCIES = (5.0, 10.0, 20.0, 40.0, 65.0, 80.0, 100.0)
+FREQUENCY_RANGE = (1.0, 100.0)                # Hz
+RECORD_FREQUENCY = 10.0                       # Hz: the recorded run (at full amplitude it trots upright there)
+#: leg name -> (fore +1 / aft -1, side +1 left / -1 right, trot phase of its pair)
+LEGS = {"FL": (1, 1, 0.0), "FR": (1, -1, np.pi), "RL": (-1, 1, np.pi), "RR": (-1, -1, 0.0)}
+SETTLE = 0.1                    # s at least, and SETTLE_CYCLES cycles, before measuring
+SETTLE_CYCLES, MEASURE_CYCLES, MEASURE_MIN = 2, 4, 0.2      # cycles, cycles, s
+SAMPLES_PER_CYCLE = 50
+RAMP_CYCLES = 2                 # the drive's amplitude grows over these (SoftStart)
+STANCE_GAP = 10e-6              # m, a foot this close to the ground is in stance (2 % of its radius)
+UPRIGHT_DEG = 30.0              # deg: a body within this roll and pitch is upright
+GRID = 5e-3                     # m, the recording's ground grid
+SLIDE_FRACTION = 0.1            # a contact foot slides above this fraction of its stance speed
+
+
+def build(mu: float = MU, segments: int = SEGMENTS, bias: float = BIAS, incline_deg: float = 0.0,
+          d: Optional[dict] = None) -> System:
+    """The robot as a System (host in mm, mg, ms) standing on a ground plane tilted by
+    ``incline_deg`` about y (uphill along +x); ``d``: hamr_leg.design() (computed if None)."""
+    mu = check_range("mu", mu, 0.0, 10.0)
+    segments = check_integer("segments", segments, 1, 40)
+    incline = np.radians(check_range("incline_deg", incline_deg, -45.0, 45.0, "deg"))
+    d = design() if d is None else d
+    spec = mujoco.MjSpec.from_string('<mujoco><option gravity="0 0 -9.80665e-3"/><worldbody/></mujoco>')
+    wb = spec.worldbody
+    # the ground: a plane turned about y by -incline (its +x rises), the robot on it
+    q_ground = [np.cos(-incline / 2), 0.0, np.sin(-incline / 2), 0.0]
+    wb.add_geom(name="ground", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[200.0, 200.0, 1.0], quat=q_ground,
+                rgba=[0.85, 0.85, 0.8, 1], contype=0, conaffinity=1, condim=3)
+    mm = 1e3
+    L, W, H = BODY_LENGTH * mm, BODY_WIDTH * mm, BODY_HEIGHT * mm
+    hip_height = (FOOT_DROP + FOOT_RADIUS) * mm + 0.02          # feet 20 um above the ground at the start
+    R_ground = np.zeros(9)
+    mujoco.mju_quat2Mat(R_ground, np.array(q_ground))
+    body = wb.add_body(name="body", pos=(R_ground.reshape(3, 3) @ [0, 0, hip_height]).tolist(), quat=q_ground)
+    body.add_freejoint(name="root")
+    box = body.add_geom(name="chassis", type=mujoco.mjtGeom.mjGEOM_BOX, size=[L / 2, W / 2, H / 2], pos=[0, 0, H / 2],
+                        mass=TOTAL_MASS * 1e6 / 2, rgba=[0.25, 0.3, 0.4, 0.5], contype=0, conaffinity=0)
+    acts = {}
+    for leg, (fore, side, _) in LEGS.items():
+        for k, dof in enumerate(("swing", "lift")):
+            # clamps 2 mm either side of the middle, the beams running toward their hips
+            site = body.add_site(name=f"{leg}_{dof}_mount", pos=[fore * 2.0, side * (2.5 + 3.0 * k), H - 1.0 - 2.0 * k],
+                                 quat=[1, 0, 0, 0] if fore > 0 else [0, 0, 0, 1])
+            acts[f"{leg}_{dof}"] = attach(spec, ACTUATOR, site=site.name, prefix=f"{leg}_{dof}", contact=False,
+                                          drive_params={"bias": bias}, segments=segments)
+    for leg, (fore, side, _) in LEGS.items():
+        add_leg(spec, body, {dof: acts[f"{leg}_{dof}"] for dof in ("swing", "lift")}, d, prefix=f"{leg}/",
+                pos=[fore * HIP_X * mm, side * W / 2, 0.0], side=side, mass_radius=LEG_LENGTH * mm,
+                foot_drop=FOOT_DROP * mm, foot_radius=FOOT_RADIUS * mm, foot_contact=True)
+    # the body's own mass: what the actuators and legs leave of TOTAL_MASS
+    m = spec.copy().compile()
+    bid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "body")
+    others = m.body_subtreemass[bid] - box.mass
+    own = TOTAL_MASS * 1e6 - others
+    if own <= 0:
+        raise ParameterError("TOTAL_MASS", TOTAL_MASS, f"more than the actuators and legs ({others * 1e-6:.4g} kg)")
+    box.mass = own
+    acts_list = list(acts.values())
+    u = acts_list[0].twin.units
+    h = min(a.twin.timestep for a in acts_list)
+    contact = ContactParameters(friction=(mu, 5e-6, 1e-7), impratio=IMPRATIO, width_fraction=CONTACT_WIDTH_FRACTION)
+    # System applies contact parameters only for actuators with contact: here the feet's
+    contact.apply(spec, h / u.time, FOOT_RADIUS / u.length, u.length)
+    return System(spec, acts_list, contact=contact)
+
+
+class SoftStart:
+    """A waveform (mjeap's text) whose oscillation about its offset grows linearly from zero
+    over ``ramp`` s, then runs as written: the run starts at the drive's rest voltage with
+    no step (a lift actuator 90 degrees ahead would otherwise jump by V_bias/2 at t = 0 and
+    kick the robot off the ground). Doshi's HAMR simulations ramp their drive the same way,
+    over 2 cycles."""
+
+    def __init__(self, text: str, ramp: float):
+        self.wave = parse_waveform(text)
+        self.ramp = float(ramp)
+        self.text = f"{text}, amplitude ramped over {self.ramp:.4g} s"
+
+    def __call__(self, t):
+        t = np.asarray(t, dtype=float)
+        off = self.wave.offset
+        return off + np.clip(t / self.ramp, 0.0, 1.0) * (self.wave(t) - off)
+
+
+def trot_voltages(frequency: float, amplitude: float = AMPLITUDE, bias: float = BIAS,
+                  ramp_cycles: float = RAMP_CYCLES) -> dict:
+    """The trot, one waveform per actuator prefix: sine of ``amplitude`` about V_bias / 2 at
+    ``frequency``; the diagonal pairs in phase, the pairs 180 degrees apart, each lift 90
+    degrees ahead of its swing (mjeap's 'phase=' key, rad); amplitude ramped over
+    ``ramp_cycles`` cycles (:class:`SoftStart`)."""
+    frequency = check_range("frequency", frequency, *FREQUENCY_RANGE, "Hz")
+    amplitude = check_range("amplitude", amplitude, 0.0, 0.5 * bias, "V")
+    out = {}
+    for leg, (_, _, phase) in LEGS.items():
+        for dof, lead in (("swing", 0.0), ("lift", 0.5 * np.pi)):
+            text = f"sine:{amplitude:g}V@{frequency:g}Hz,offset={0.5 * bias:g}V,phase={phase + lead:.17g}"
+            out[f"{leg}_{dof}"] = SoftStart(text, ramp_cycles / frequency)
+    return out
+
+
+def body_position(system: System) -> np.ndarray:
+    """The body's world position (m)."""
+    return system.data.body("body").xpos * system.units.length
+
+
+def body_rotation(system: System) -> np.ndarray:
+    """The body's world rotation (3 x 3)."""
+    return system.data.body("body").xmat.reshape(3, 3).copy()
+
+
+def feet(system: System) -> np.ndarray:
+    """The four feet's world positions (m), in LEGS order."""
+    return np.array([system.data.site(f"{leg}/foot").xpos for leg in LEGS]) * system.units.length
+
+
+def ground_rotation(system: System) -> np.ndarray:
+    """The ground plane's world rotation: its x uphill (forward), z its normal."""
+    return system.data.geom("ground").xmat.reshape(3, 3).copy()
+
+
+def roll_pitch(R: np.ndarray, G: np.ndarray) -> tuple:
+    """Roll and pitch (rad) of a body rotation ``R`` relative to the ground's ``G``."""
+    Rr = G.T @ R
+    return float(np.arctan2(Rr[2, 1], Rr[2, 2])), float(np.arcsin(np.clip(-Rr[2, 0], -1, 1)))
+
+
+def _durations(frequency: float, settle: Optional[float], measure: Optional[float]) -> tuple:
+    """(settle, measure) in s, each whole cycles."""
+    T = 1.0 / frequency
+    s = settle if settle is not None else max((RAMP_CYCLES + SETTLE_CYCLES) * T, SETTLE)
+    m = measure if measure is not None else max(MEASURE_CYCLES * T, MEASURE_MIN)
+    return np.ceil(s / T - 1e-9) * T, np.ceil(m / T - 1e-9) * T
+
+
+def walk(system: System, frequency: float, amplitude: float = AMPLITUDE, settle: Optional[float] = None,
+         measure: Optional[float] = None, samples_per_cycle: int = SAMPLES_PER_CYCLE) -> dict:
+    """Trot open loop at ``frequency`` (Hz) for ``settle`` + ``measure`` s (defaults: whole
+    cycles, see SETTLE and MEASURE_*). Returns the samples (SI, world): time, body position
+    and rotation, the feet's positions and velocities, which feet touch the ground, the
+    deepest penetration; the rollout's result; the measuring window's start ``t0``."""
+    bias = system.actuators[0].drive.params["bias"]
+    settle, measure = _durations(frequency, settle, measure)
+    fid = [mujoco.mj_name2id(system.model, mujoco.mjtObj.mjOBJ_GEOM, f"{leg}/foot") for leg in LEGS]
+    sid = [mujoco.mj_name2id(system.model, mujoco.mjtObj.mjOBJ_SITE, f"{leg}/foot") for leg in LEGS]
+    rows = {k: [] for k in ("body", "R", "feet", "feet_velocity", "contact", "penetration")}
+    v6 = np.zeros(6)
+
+    def on_sample(sy):
+        m, d = sy.model, sy.data
+        rows["body"].append(body_position(sy))
+        rows["R"].append(body_rotation(sy))
+        rows["feet"].append(feet(sy))
+        vel = []
+        for s_ in sid:
+            mujoco.mj_objectVelocity(m, d, mujoco.mjtObj.mjOBJ_SITE, s_, v6, 0)
+            vel.append(v6[3:].copy())
+        rows["feet_velocity"].append(np.array(vel) * sy.units.length / sy.units.time)
+        touching = {d.contact[i].geom1 for i in range(d.ncon)} | {d.contact[i].geom2 for i in range(d.ncon)}
+        rows["contact"].append([g in touching for g in fid])
+        rows["penetration"].append(sy.penetration())
+
+    res = system.rollout(trot_voltages(frequency, amplitude, bias), settle + measure,
+                         sample_interval=1.0 / (samples_per_cycle * frequency), on_sample=on_sample)
+    run = {k: np.array(v) for k, v in rows.items()}
+    run.update(time=res.time[:len(rows["body"])], result=res, frequency=float(frequency), amplitude=float(amplitude),
+               t0=float(settle), ground=ground_rotation(system))
+    return run
+
+
+def walk_metrics(run: dict) -> dict:
+    """The read-outs of a :func:`walk` over its measuring window (see the module text)."""
+    t, f, G = run["time"], run["frequency"], run["ground"]
+    k = t >= run["t0"] - 1e-12
+    tw = t[k]
+    fwd, up = G[:, 0], G[:, 2]
+    p = run["body"][k]
+    duration = tw[-1] - tw[0]
+    speed = float((p[-1] - p[0]) @ fwd / duration)
+    lateral = float((p[-1] - p[0]) @ G[:, 1] / duration)
+    rp = np.degrees(np.array([roll_pitch(R, G) for R in run["R"][k]]))
+    # the feet in the body frame: their fore-aft speed relative to the body
+    rel = np.einsum("nji,nkj->nki", run["R"], run["feet"] - run["body"][:, None, :])     # R^T (foot - body)
+    v_rel = np.gradient(rel[..., 0], t, axis=0)[k]                                        # (n, 4) m/s
+    gap = run["feet"] @ up - FOOT_RADIUS                  # the feet's clearance (the plane passes the origin)
+    c = (gap < STANCE_GAP)[k]                             # in stance (MuJoCo's contact flickers at zero depth)
+    any_c = c.any(axis=1)
+    stance_back = np.where(c, -v_rel, 0.0)
+    v_est = np.where(any_c, stance_back.sum(axis=1) / np.maximum(c.sum(axis=1), 1), np.nan)
+    dt = np.gradient(tw)
+    stroke = float((stance_back * dt[:, None]).sum() / 4 / (duration * f))      # per foot per cycle
+    duty = float(c.mean())
+    stance_speed = float(np.abs(v_rel[c]).mean()) if c.any() else 0.0
+    vf = run["feet_velocity"][k]
+    v_t = np.linalg.norm(vf - (vf @ up)[..., None] * up, axis=-1)
+    threshold = max(SLIDE_FRACTION * stance_speed, 1e-4)
+    slides = (v_t > threshold) & c
+    return {
+        "frequency_hz": f, "amplitude_v": run["amplitude"],
+        "speed_m_s": speed, "lateral_drift_m_s": lateral,
+        "kinematic_speed_m_s": float(np.nanmean(v_est)) if any_c.any() else None,    # None: no foot ever down
+        "stance_stroke_m": stroke, "duty_factor": duty,
+        "stroke_f_over_duty_m_s": stroke * f / duty if duty > 0 else None,
+        "time_with_a_foot_down": float(any_c.mean()),
+        "slip_fraction": float(slides.sum() / max(c.sum(), 1)), "slide_threshold_m_s": threshold,
+        "max_abs_roll_deg": float(np.abs(rp[:, 0]).max()), "max_abs_pitch_deg": float(np.abs(rp[:, 1]).max()),
+        "mean_roll_deg": float(rp[:, 0].mean()), "mean_pitch_deg": float(rp[:, 1].mean()),
+        "body_height_range_m": [float((p @ up).min()), float((p @ up).max())],
+        "max_penetration_m": float(run["penetration"].max()),
+        "contact_tolerance_m": CONTACT_WIDTH_FRACTION * FOOT_RADIUS,
+        "measured_s": float(duration), "simulated_s": float(t[-1]),
+        "wall_time_s": float(run["result"].meta["wall_time_s"]),
+        "wall_s_per_simulated_s": float(run["result"].meta["wall_time_s"] / t[-1]),
+    }
+
+
+def segment_effect(segments: Sequence[int] = (2, SEGMENTS, 20), frequencies: Sequence[float] = (20.0, 65.0)) -> dict:
+    """The single leg (hamr_leg.build, its design) with ``segments`` per actuator: each
+    transmission's foot gain (m/V, hamr_leg.sweep) at ``frequencies``, and the foot
+    amplitude (m) it gives at this robot's full AMPLITUDE. The design's inertias are sized
+    on the 20-segment beam; fewer segments stiffen the chain (its static gain and first
+    mode move by ~1/N^2), which moves the foot amplitude by what is reported here."""
+    d = design()
+    out = {}
+    for n in segments:
+        system = hamr_leg.build(d, segments=n)
+        row = {"timestep_s": system.timestep}
+        for dof in ("swing", "lift"):
+            sw = hamr_leg.sweep(system, dof, np.asarray(frequencies, dtype=float))
+            row[dof] = {f"{f:g}_hz": {"gain_m_per_v": g, "amplitude_m": g * AMPLITUDE}
+                        for f, g in zip(sw["frequency_hz"], sw["magnitude_m_per_V"])}
+        out[str(n)] = row
+    ref = out[str(max(segments))]
+    for n in segments:
+        for dof in ("swing", "lift"):
+            for key, v in out[str(n)][dof].items():
+                v["relative_to_most_segments"] = v["gain_m_per_v"] / ref[dof][key]["gain_m_per_v"] - 1.0
+    return out
+
+
+def max_incline(frequency: float = RECORD_FREQUENCY, amplitude: float = AMPLITUDE, mu: float = MU,
+                segments: int = SEGMENTS, step: float = 4.0, top: float = 32.0) -> dict:
+    """The steepest ground incline (deg, in ``step`` up to ``top``) on which the trot at
+    ``frequency`` still climbs: forward speed along the slope > 0 with the body upright
+    (|roll| and |pitch| below UPRIGHT_DEG) over the measuring window. The ground is tilted,
+    gravity stays along -z (attach sizes the actuators for it)."""
+    d = design()
+    tried, best = [], None
+    for angle in np.arange(0.0, top + 1e-9, step):
+        m = walk_metrics(walk(build(mu, segments, incline_deg=float(angle), d=d), frequency, amplitude))
+        ok = m["speed_m_s"] > 0 and upright(m)
+        tried.append({"incline_deg": float(angle), "speed_m_s": m["speed_m_s"], "upright": upright(m)})
+        if not ok:
+            break
+        best = float(angle)
+    return {"frequency_hz": frequency, "max_incline_deg": best, "step_deg": step, "tried": tried,
+            "paper_incline_deg": PAPER_INCLINE}
+
+
+def upright(metrics: dict) -> bool:
+    """|roll| and |pitch| stayed below UPRIGHT_DEG over the measuring window."""
+    return bool(metrics["max_abs_roll_deg"] < UPRIGHT_DEG and metrics["max_abs_pitch_deg"] < UPRIGHT_DEG)
+
+
+def write_recording(path, system: System, run: dict) -> None:
+    """The run in 3D at true scale (the body, the eight actuators, the legs, the feet) over a
+    5 mm ground grid, each foot's trail and the body's path; plots of the body's forward
+    speed (instantaneous, per cycle, the paper's 0.5 m/s at 65 Hz), its roll and pitch and
+    the feet's clearance."""
+    import rerun as rr
+    import rerun.blueprint as rrb
+    from ..io.recording import write_system_recording, x_axis, y_axis
+
+    t, f, G = run["time"], run["frequency"], run["ground"]
+    fwd, up = G[:, 0], G[:, 2]
+    x_body = run["body"] @ fwd
+    v_inst = np.gradient(x_body, t)
+    n_cyc = int(np.floor(t[-1] * f + 1e-9))
+    t_cyc = (np.arange(n_cyc) + 1) / f
+    x_cyc = np.interp(np.arange(n_cyc + 1) / f, t, x_body)
+    v_cyc = np.diff(x_cyc) * f
+    rp = np.degrees(np.array([roll_pitch(R, G) for R in run["R"]]))
+    clearance = run["feet"] @ up - FOOT_RADIUS
+    colours = {"FL": [230, 80, 60], "FR": [60, 120, 230], "RL": [240, 170, 40], "RR": [60, 180, 90]}
+
+    def extra(rec):
+        lo = min(run["feet"][..., 0].min(), run["body"][:, 0].min()) - 0.02
+        hi = max(run["feet"][..., 0].max(), run["body"][:, 0].max()) + 0.02
+        xs = np.arange(np.floor(lo / GRID) * GRID, hi + GRID, GRID)
+        ys = np.arange(-0.03, 0.03 + 1e-9, GRID)
+        lines = [[G @ [x, ys[0], 0], G @ [x, ys[-1], 0]] for x in xs] + \
+                [[G @ [xs[0], y, 0], G @ [xs[-1], y, 0]] for y in ys]
+        rec.log("world/ground_grid", rr.LineStrips3D(lines, colors=[[150, 150, 150]], radii=[2e-5]), static=True)
+        for i, leg in enumerate(LEGS):
+            rec.log(f"world/foot_trails/{leg}", rr.LineStrips3D([run["feet"][:, i]], colors=[colours[leg]],
+                                                                 radii=[6e-5], labels=[f"{leg} foot"]), static=True)
+        rec.log("world/body_path", rr.LineStrips3D([run["body"]], colors=[[40, 40, 40]], radii=[6e-5],
+                                                   labels=["body"]), static=True)
+        tc = [rr.TimeColumn("time", duration=t)]
+        for ent, label, colour, ts, values in (
+                ("walk/speed/instantaneous", "body forward speed (m/s)", [150, 150, 150], t, v_inst),
+                ("walk/speed/per_cycle", "per cycle (m/s)", [40, 110, 220], t_cyc, v_cyc),
+                ("walk/speed/paper", f"paper: {PAPER_SPEED} m/s at {PAPER_FREQUENCY:g} Hz", [230, 150, 40], t,
+                 np.full(len(t), PAPER_SPEED)),
+                ("walk/attitude/roll", "roll (deg)", [220, 60, 60], t, rp[:, 0]),
+                ("walk/attitude/pitch", "pitch (deg)", [40, 110, 220], t, rp[:, 1])) + tuple(
+                (f"walk/clearance/{leg}", f"{leg} foot clearance (m)", colours[leg], t, clearance[:, i])
+                for i, leg in enumerate(LEGS)):
+            rec.log(ent, rr.SeriesLines(names=label, colors=[colour]), static=True)
+            rec.send_columns(ent, indexes=[rr.TimeColumn("time", duration=ts)] if ts is not t else tc,
+                             columns=rr.Scalars.columns(scalars=np.asarray(values, dtype=float)))
+
+    views = (rrb.TimeSeriesView(origin="/walk/speed", name=f"forward speed (m/s) at {f:g} Hz",
+                                axis_y=y_axis(v_cyc, [0.0, PAPER_SPEED]), axis_x=x_axis(t)),
+             rrb.TimeSeriesView(origin="/walk/attitude", name="roll and pitch (deg)", axis_y=y_axis(rp),
+                                axis_x=x_axis(t)),
+             rrb.TimeSeriesView(origin="/walk/clearance", name="foot clearance above the ground (m)",
+                                axis_y=y_axis(clearance), axis_x=x_axis(t)))
+    write_system_recording(path, run["result"], system, extra=extra, views=views, actuator_views=False)
+
+
+def model_summary(system: System) -> dict:
+    """Masses and dimensions of the built robot (SI), with what is cited and what assumed."""
+    m = system.model
+    u = system.units
+    mass = {}
+    for b in range(1, m.nbody):
+        name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b)
+        key = "body" if name == "body" else "actuators" if "_swing/" in name or "_lift/" in name else "legs"
+        mass[key] = mass.get(key, 0.0) + float(m.body_mass[b]) * u.mass
+    return {"total_mass_kg": float(m.body_subtreemass[1] * u.mass), "mass_kg": mass,
+            "body_length_m": BODY_LENGTH, "body_width_m": BODY_WIDTH, "body_height_m": BODY_HEIGHT,
+            "hip_x_m": HIP_X, "leg_length_m": LEG_LENGTH, "foot_drop_m": FOOT_DROP, "foot_radius_m": FOOT_RADIUS,
+            "timestep_s": system.timestep, "segments": system.parts[0].layout.segments,
+            "cited": {"total mass, body length, 0.5 m/s at 65 Hz, 22 deg": "seed 003 section 6.2 (Jayaram 2018)",
+                      "T_swing 13, T_lift 12, resonances 100 / 80 Hz": "seed 003 section 6.2 (its refs [51], [19])",
+                      "foot 11.35 mm below its leg frame, mu 0.51, drive ramped over 2 cycles":
+                          "N. Doshi's HAMR Drake simulation scripts (HamrRBM FOOT_POS, trot sweeps MU)"},
+            "assumed": ["body width and height", "hip spacing", "leg length (hamr_leg)", "foot radius",
+                        "the legs' mass radius (= leg length)", "contact: MuJoCo soft, elliptic cone, impratio 10"]}
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=summary(__doc__))
+    ap.add_argument("--out", default="out/hamr_walk.rrd", type=arg_output(), help="recording (.rrd)")
+    ap.add_argument("--frequencies", nargs="+", type=arg_number(*FREQUENCY_RANGE, "Hz"), default=list(FREQUENCIES),
+                    help=f"trot frequencies (Hz, {FREQUENCY_RANGE[0]:g} to {FREQUENCY_RANGE[1]:g})")
+    ap.add_argument("--record-frequency", type=arg_number(*FREQUENCY_RANGE, "Hz"), default=RECORD_FREQUENCY,
+                    help="the frequency of the recorded run (Hz)")
+    ap.add_argument("--amplitude", type=arg_number(0.0, AMPLITUDE, "V", lo_open=True), default=AMPLITUDE,
+                    help=f"drive amplitude about V_bias / 2 (V; {AMPLITUDE:g}: full, the signal swings 0..{BIAS:g} V)")
+    ap.add_argument("--mu", type=arg_number(0.0, 10.0), default=MU, help="foot-ground friction coefficient")
+    ap.add_argument("--segments", type=arg_integer(1, 40), default=SEGMENTS, help="segments per actuator")
+    ap.add_argument("--quick", action="store_true",
+                    help="skip the segment check and the incline search (at --record-frequency)")
+    a = parse_args(ap, argv)
+    d = design()
+    system = build(a.mu, a.segments, d=d)
+    out = {"model": model_summary(system), "amplitude_v": a.amplitude, "bias_v": BIAS, "mu": a.mu, "runs": []}
+    freqs = sorted(set(a.frequencies) | {a.record_frequency})
+    for f in freqs:
+        run = walk(system, f, a.amplitude)
+        m = walk_metrics(run)
+        m["upright"] = upright(m)
+        out["runs"].append(m)
+        if f == a.record_frequency and a.out:
+            write_recording(a.out, system, run)
+        print(f"{f:g} Hz: {m['speed_m_s']:.4g} m/s (no-slip {m['kinematic_speed_m_s'] or float('nan'):.4g}), slip "
+              f"{m['slip_fraction']:.2f}, roll/pitch {m['max_abs_roll_deg']:.1f}/{m['max_abs_pitch_deg']:.1f} deg, "
+              f"{m['wall_s_per_simulated_s']:.1f} s wall per s", file=sys.stderr)
+    at = {r["frequency_hz"]: r for r in out["runs"]}
+    if PAPER_FREQUENCY in at:
+        v, up = at[PAPER_FREQUENCY]["speed_m_s"], at[PAPER_FREQUENCY]["upright"]
+        out["speed_at_65hz_m_s"], out["paper_speed_m_s"], out["upright_at_65hz"] = v, PAPER_SPEED, up
+        # a robot that rolled over has no speed to compare
+        out["speed_over_paper"] = v / PAPER_SPEED if up else None
+    low = at[min(at)]
+    k = low["kinematic_speed_m_s"]
+    out["kinematic_check"] = {"frequency_hz": low["frequency_hz"], "speed_m_s": low["speed_m_s"],
+                              "no_slip_estimate_m_s": k, "relative_error": None if not k else low["speed_m_s"] / k - 1.0}
+    out["wall_s_per_simulated_s"] = float(np.mean([r["wall_s_per_simulated_s"] for r in out["runs"]]))
+    if not a.quick:
+        out["segment_effect"] = segment_effect()
+        out["incline"] = max_incline(a.record_frequency, a.amplitude, a.mu, a.segments)
+    out["recording"] = a.out
+    print(json.dumps(out, indent=1, default=float))
+
+
+register(Robot("hamr-walk", summary(__doc__), build, main,
+               {"body_position": body_position, "feet": feet,
+                "roll_pitch": lambda s: np.array(roll_pitch(body_rotation(s), ground_rotation(s)))},
+               ("hamr", "piezo", "transmission", "legged", "contact")))
+
+if __name__ == "__main__":
+    sys.exit(run_script(main))
