@@ -41,6 +41,214 @@ def write_hinge_angles(qpos: np.ndarray, qposadr: np.ndarray, angles, hinge: boo
         qpos[qposadr + 3] = np.sin(half)
 
 
+class BeamView:
+    """How one beam representation reads and drives its bending in a compiled model
+    (internal units): made by its builder (:meth:`mjeap.mjcf.BeamBuilder.view`) for an
+    :class:`ActuatorPart`, which holds the SI side. ``bend_dof``: the generalised dof that
+    carries each hinge's bending (None where no dof does, e.g. the rod's vertices)."""
+
+    bend_dof: Optional[np.ndarray] = None
+
+    def bind(self, data: mujoco.MjData) -> None:
+        """Views of ``data`` for the per-step paths (made once per MjData)."""
+        self.data = data
+
+    def angles(self, out: Optional[np.ndarray] = None) -> np.ndarray:
+        """Bending angle (rad) of every hinge about the hinge axis."""
+        raise NotImplementedError
+
+    def rates(self, out: Optional[np.ndarray] = None) -> np.ndarray:
+        """Bending rate of every hinge (rad per internal time unit)."""
+        raise NotImplementedError
+
+    def write_angles(self, qpos: np.ndarray, angles: np.ndarray) -> None:
+        """Write a configuration bent by ``angles`` (rad per hinge) into ``qpos``."""
+        raise NotImplementedError
+
+    def zero_rates(self, qvel: np.ndarray) -> None:
+        """Set the beam's velocities in ``qvel`` to zero."""
+        raise NotImplementedError
+
+    def moments_of(self, qfrc: np.ndarray) -> np.ndarray:
+        """The moment (internal) about every hinge of a generalised force ``qfrc`` (nv,): its
+        virtual work per unit bending of that hinge, all others held."""
+        raise NotImplementedError
+
+    def apply_moments(self, moments, scale: float, stiffness_change: Optional[np.ndarray]) -> None:
+        """Apply the moments ``moments`` x ``scale`` (internal units; scalar or one per
+        hinge) as equal and opposite couples on the two parts each hinge joins, replacing
+        the previous call's. ``stiffness_change``: per-hinge stiffness (internal) to add to
+        the beam's own where the model cannot change it (None: nothing to add)."""
+        raise NotImplementedError
+
+    def set_stiffness(self, k: np.ndarray, factor: float) -> bool:
+        """Set every hinge's bending stiffness to ``k`` x ``factor`` (internal) in the model;
+        False where the model's stiffness is fixed (the change then goes in as a moment)."""
+        return False
+
+    def damping(self) -> np.ndarray:
+        """Present viscous damping of every hinge's bending (internal)."""
+        raise NotImplementedError
+
+    def scale_damping(self, factor: float) -> None:
+        """Scale the beam's damping to ``factor`` x its value as built."""
+        raise NotImplementedError
+
+    def set_damping(self, b: np.ndarray) -> None:
+        """Set every hinge's viscous damping (internal), replacing the built value."""
+        raise NotImplementedError
+
+    def save_damping(self):
+        """The model's present damping, for :meth:`scale_saved_damping` and
+        :meth:`restore_damping` (a scene settling with extra damping)."""
+        return self.model.dof_damping.copy()
+
+    def scale_saved_damping(self, saved, factor: float) -> None:
+        self.model.dof_damping[:] = saved * factor
+
+    def restore_damping(self, saved) -> None:
+        self.model.dof_damping[:] = saved
+
+
+class JointView(BeamView):
+    """A beam whose hinges are joints: one generalised dof per hinge carries its bending
+    (a hinge joint, or a ball joint's rotation about its local z axis, ``offset`` 2), its
+    damping is that dof's ``dof_damping``."""
+
+    offset = 0
+
+    def __init__(self, model: mujoco.MjModel, joint_ids: np.ndarray):
+        m = self.model = model
+        self.joint_ids = joint_ids
+        self.joint_qpos = m.jnt_qposadr[joint_ids]
+        self.joint_dof = m.jnt_dofadr[joint_ids]
+        self.bend_dof = self.joint_dof + self.offset
+        # the same as slices (views, no copies) when evenly spaced, for the per-step paths
+        self._bend_sl = as_slice(self.bend_dof)
+        self._d0 = m.dof_damping.copy()
+        self._dof_damping_bend = m.dof_damping[self._bend_sl] if isinstance(self._bend_sl, slice) else None
+        self._d0_bend = self._d0[self._bend_sl]
+        self._qfrc_bend = self._qvel_bend = None
+
+    def bind(self, data):
+        """Views (no copies) of the bending dofs in qvel and qfrc_applied, made once, so
+        the per-step paths of the drives allocate nothing; None where the dofs are not
+        evenly spaced (the indexed fallback then copies)."""
+        self.data = d = data
+        sl = self._bend_sl
+        strided = isinstance(sl, slice)
+        self._qfrc_bend = d.qfrc_applied[sl] if strided else None
+        self._qvel_bend = d.qvel[sl] if strided else None
+
+    def rates(self, out=None):
+        return self._qvel_bend if self._qvel_bend is not None else self.data.qvel[self._bend_sl]
+
+    def moments_of(self, qfrc):
+        return qfrc[self.bend_dof]
+
+    def apply_moments(self, moments, scale, stiffness_change):
+        if stiffness_change is not None:
+            M = np.multiply(moments, scale)
+            M = M - stiffness_change * self.angles()
+            self.data.qfrc_applied[self._bend_sl] = M
+        elif self._qfrc_bend is not None:   # the per-step path: no allocation
+            if isinstance(moments, np.ndarray) and moments.ndim:
+                np.multiply(moments, scale, out=self._qfrc_bend)
+            else:
+                self._qfrc_bend.fill(float(moments) * scale)
+        else:
+            self.data.qfrc_applied[self._bend_sl] = np.multiply(moments, scale)
+
+    def damping(self):
+        return self.model.dof_damping[self.bend_dof]
+
+    def scale_damping(self, factor):
+        if self._dof_damping_bend is not None:
+            np.multiply(self._d0_bend, factor, out=self._dof_damping_bend)
+        else:
+            self.model.dof_damping[self.bend_dof] = self._d0[self.bend_dof] * factor
+
+    def set_damping(self, b):
+        self._d0[self.bend_dof] = b
+
+
+class HingeView(JointView):
+    """The hinge chain: hinge joints, angle = qpos; stiffness is the joints' own."""
+
+    def __init__(self, model, joint_ids):
+        super().__init__(model, joint_ids)
+        self._qpos_sl = as_slice(self.joint_qpos)
+        jsl = as_slice(joint_ids)
+        self._jnt_stiffness_bend = model.jnt_stiffness[jsl] if isinstance(jsl, slice) else None
+        self._qpos_bend = None
+
+    def bind(self, data):
+        super().bind(data)
+        self._qpos_bend = data.qpos[self._qpos_sl] if isinstance(self._qpos_sl, slice) else None
+
+    def angles(self, out=None):
+        if self._qpos_bend is not None:
+            if out is None:
+                return self._qpos_bend.copy()
+            np.copyto(out, self._qpos_bend)
+            return out
+        a = self.data.qpos[self.joint_qpos]          # indexed fallback (copies)
+        if out is None:
+            return a
+        np.copyto(out, a)
+        return out
+
+    def write_angles(self, qpos, angles):
+        write_hinge_angles(qpos, self.joint_qpos, angles, True)
+
+    def zero_rates(self, qvel):
+        qvel[self.joint_dof] = 0
+
+    def set_stiffness(self, k, factor):
+        if self._jnt_stiffness_bend is not None:
+            np.multiply(k, factor, out=self._jnt_stiffness_bend)
+        else:
+            self.model.jnt_stiffness[self.joint_ids] = k * factor
+        return True
+
+
+class CableView(JointView):
+    """The cable: ball joints, the bending angle 2 atan2(q_z, q_w) of each quaternion and
+    its rotation dof about the local z axis; the plugin's stiffness is fixed at init."""
+
+    offset = 2
+
+    def __init__(self, model, joint_ids):
+        super().__init__(model, joint_ids)
+        self._quat_sl = (as_slice(self.joint_qpos), as_slice(self.joint_qpos + 3))
+        self._quat_wz = None
+
+    def bind(self, data):
+        super().bind(data)
+        self._quat_wz = tuple(data.qpos[q] for q in self._quat_sl) \
+            if all(isinstance(q, slice) for q in self._quat_sl) else None
+
+    def angles(self, out=None):
+        if self._quat_wz is not None:              # 2 atan2(q_z, q_w)
+            a = np.arctan2(self._quat_wz[1], self._quat_wz[0], out=out)
+            a *= 2.0
+            return a
+        q = self.data.qpos                         # indexed fallback (copies)
+        a = 2 * np.arctan2(q[self.joint_qpos + 3], q[self.joint_qpos])
+        if out is None:
+            return a
+        np.copyto(out, a)
+        return out
+
+    def write_angles(self, qpos, angles):
+        write_hinge_angles(qpos, self.joint_qpos, angles, False)
+
+    def zero_rates(self, qvel):
+        qvel[self.joint_dof] = 0
+        qvel[self.joint_dof + 1] = 0
+        qvel[self.joint_dof + 2] = 0
+
+
 class ActuatorPart:
     """A beam in a compiled model. ``handles`` (:class:`mjeap.mjcf.BeamHandles`) name its
     parts as built; ``prefix`` is prepended to every name (``'left/'`` after
@@ -62,32 +270,22 @@ class ActuatorPart:
 
         body = lambda n: find(mujoco.mjtObj.mjOBJ_BODY, n)  # noqa: E731
         h = handles
+        from .mjcf import BUILDERS
+        #: the beam's representation (:class:`mjeap.mjcf.BeamBuilder`): how its bending is
+        #: read, set and driven in this model (its :class:`BeamView`)
+        self.builder = BUILDERS[representation]
         self.clamp_id = body(h.clamp_body)
         self.link_ids = np.array([body(n) for n in h.link_bodies])
         self.tip_body_id = body(h.tip_body)
         self.tip_site_id = find(mujoco.mjtObj.mjOBJ_SITE, h.tip_site)
         self.payload_id = body(h.payload_body) if h.payload_body else -1
         self.tip_load_id = body(h.tip_load_body)
-        self.joint_ids = np.array([find(mujoco.mjtObj.mjOBJ_JOINT, n) for n in h.joints])
-        self.joint_qpos = m.jnt_qposadr[self.joint_ids]
-        self.joint_dof = m.jnt_dofadr[self.joint_ids]
-        # the bending dof of each hinge: the hinge itself, or a ball joint's rotation about
-        # the local z (hinge) axis
-        self.bend_dof = self.joint_dof + (0 if representation == "hinge" else 2)
-        # the same as slices (views, no copies) when evenly spaced, for the per-step paths
-        self._bend_sl = as_slice(self.bend_dof)
-        self._qpos_sl = as_slice(self.joint_qpos) if representation == "hinge" else None
-        # a ball joint's bending angle is 2 atan2(q_z, q_w) of its quaternion
-        self._quat_sl = None if representation == "hinge" else \
-            (as_slice(self.joint_qpos), as_slice(self.joint_qpos + 3))
+        self.joint_ids = np.array([find(mujoco.mjtObj.mjOBJ_JOINT, n) for n in h.joints], dtype=int)
+        self.view = self.builder.view(m, h, layout, units, prefix, find)
+        #: the generalised dof carrying each hinge's bending (None where none does: the rod)
+        self.bend_dof = self.view.bend_dof
         self._inv_moment = 1.0 / units.moment
         self._k_bend = layout.hinge_stiffness / units.rotational_stiffness  # internal units
-        self._d0 = m.dof_damping.copy()
-        jsl = as_slice(self.joint_ids)
-        self._jnt_stiffness_bend = m.jnt_stiffness[jsl] \
-            if isinstance(jsl, slice) and representation == "hinge" else None
-        self._dof_damping_bend = m.dof_damping[self._bend_sl] if isinstance(self._bend_sl, slice) else None
-        self._d0_bend = self._d0[self._bend_sl]
         self._stiffness_scale = 1.0
         self._fixed_rotation = None if rotation is None else np.asarray(rotation, dtype=float)
         self._tip_force_world = np.zeros(3)
@@ -102,17 +300,10 @@ class ActuatorPart:
         return self._data
 
     def bind(self, data: mujoco.MjData) -> None:
-        """Views (no copies) of the bending dofs in qpos, qvel and qfrc_applied, made once,
-        so the per-step paths of the drives allocate nothing; None where the dofs are not
-        evenly spaced (the indexed fallback then copies)."""
-        self._data = d = data
-        sl = self._bend_sl
-        strided = isinstance(sl, slice)
-        self._qfrc_bend = d.qfrc_applied[sl] if strided else None
-        self._qvel_bend = d.qvel[sl] if strided else None
-        self._qpos_bend = d.qpos[self._qpos_sl] if isinstance(self._qpos_sl, slice) else None
-        self._quat_wz = tuple(d.qpos[q] for q in self._quat_sl) \
-            if self._quat_sl is not None and all(isinstance(q, slice) for q in self._quat_sl) else None
+        """Bind the part (and its beam view, whose per-step paths then allocate nothing)
+        to ``data``."""
+        self._data = data
+        self.view.bind(data)
         self.apply_loads()
 
     @property
@@ -131,55 +322,36 @@ class ActuatorPart:
         a = np.asarray(angles, dtype=float)
         if a.shape != (self.layout.segments,):
             raise ParameterError("angles", a.shape, f"an array of {self.layout.segments} angles")
-        write_hinge_angles(self._data.qpos, self.joint_qpos, a, self.representation == "hinge")
-        self._data.qvel[self.joint_dof] = 0
-        if self.representation != "hinge":
-            self._data.qvel[self.joint_dof + 1] = 0
-            self._data.qvel[self.joint_dof + 2] = 0
+        self.view.write_angles(self._data.qpos, a)
+        self.view.zero_rates(self._data.qvel)
         if forward:
             mujoco.mj_forward(self.model, self._data)
 
     def hinge_angles(self, out: Optional[np.ndarray] = None) -> np.ndarray:
         """Bending angle (rad) of every hinge about the hinge axis; written into ``out``
         (shape (segments,)) when given, which then allocates nothing."""
-        if self._qpos_bend is not None:            # hinge chain
-            if out is None:
-                return self._qpos_bend.copy()
-            np.copyto(out, self._qpos_bend)
-            return out
-        if self._quat_wz is not None:              # cable: 2 atan2(q_z, q_w)
-            a = np.arctan2(self._quat_wz[1], self._quat_wz[0], out=out)
-            a *= 2.0
-            return a
-        q = self._data.qpos                        # indexed fallback (copies)
-        a = q[self.joint_qpos] if self.representation == "hinge" else \
-            2 * np.arctan2(q[self.joint_qpos + 3], q[self.joint_qpos])
-        if out is None:
-            return a
-        np.copyto(out, a)
-        return out
+        return self.view.angles(out)
 
     def hinge_rates(self, out: Optional[np.ndarray] = None) -> np.ndarray:
         """Bending angular velocity of every hinge (rad/s); written into ``out`` when given."""
-        v = self._qvel_bend if self._qvel_bend is not None else self._data.qvel[self._bend_sl]
-        return np.multiply(v, 1.0 / self.units.time, out=out)
+        return np.multiply(self.view.rates(), 1.0 / self.units.time, out=out)
 
     def hinge_stiffness(self) -> np.ndarray:
         """Current (instantaneous) bending stiffness of every hinge (N m / rad)."""
         return self._k_bend * self.units.rotational_stiffness * self._stiffness_scale
 
     def hinge_damping(self) -> np.ndarray:
-        """Current viscous damping of every hinge's bending dof (N m s / rad)."""
-        return self.model.dof_damping[self.bend_dof] * self.units.rotational_damping
+        """Current viscous damping of every hinge's bending (N m s / rad)."""
+        return self.view.damping() * self.units.rotational_damping
 
     def gravity_moments(self) -> np.ndarray:
-        """Moment (N m) that gravity exerts on every hinge's bending dof at the current
+        """Moment (N m) that gravity exerts on every hinge's bending at the current
         configuration (at rest)."""
         d = self._data
         saved = d.qvel.copy()
         d.qvel[:] = 0
         mujoco.mj_forward(self.model, d)
-        out = -d.qfrc_bias[self.bend_dof] * self.units.moment
+        out = -self.view.moments_of(d.qfrc_bias) * self.units.moment
         d.qvel[:] = saved
         mujoco.mj_forward(self.model, d)
         return out
@@ -187,20 +359,17 @@ class ActuatorPart:
     # ------------------------------------------------------------------ forces
     def set_internal_moments(self, moments) -> None:
         """Internal bending moment (N m) at every hinge (scalar: the same everywhere), applied
-        as equal and opposite couples on the two links it joins, i.e. a generalised force
-        on the hinge's bending dof. Replaces the previous call's moments."""
-        if self._stiffness_scale != 1.0 and self.representation != "hinge":
-            # the cable plugin's stiffness is fixed at init: add the change as a moment
-            M = np.multiply(moments, self._inv_moment)
-            M = M - (self._stiffness_scale - 1.0) * self._k_bend * self.hinge_angles()
-            self._data.qfrc_applied[self._bend_sl] = M
-        elif self._qfrc_bend is not None:   # the per-step path: no allocation
-            if isinstance(moments, np.ndarray) and moments.ndim:
-                np.multiply(moments, self._inv_moment, out=self._qfrc_bend)
-            else:
-                self._qfrc_bend.fill(float(moments) * self._inv_moment)
-        else:
-            self._data.qfrc_applied[self._bend_sl] = np.multiply(moments, self._inv_moment)
+        as equal and opposite couples on the two parts it joins (a generalised force on the
+        hinge's bending). Replaces the previous call's moments."""
+        change = None
+        if self._stiffness_scale != 1.0 and not self._stiffness_in_model:
+            # a model whose stiffness is fixed at init (the cable plugin): add the change as a moment
+            change = (self._stiffness_scale - 1.0) * self._k_bend
+        self.view.apply_moments(moments, self._inv_moment, change)
+
+    #: whether the model's own stiffness follows set_bending_stiffness_scale (else the
+    #: change is applied as a moment with the drives' moments)
+    _stiffness_in_model = True
 
     def set_bending_stiffness_scale(self, factor: float) -> None:
         """Scale every hinge's bending stiffness (and its Rayleigh damping, which keeps the
@@ -210,14 +379,8 @@ class ActuatorPart:
             return
         f = check_positive("stiffness factor", factor)
         self._stiffness_scale = f
-        if self._jnt_stiffness_bend is not None:
-            np.multiply(self._k_bend, f, out=self._jnt_stiffness_bend)
-        elif self.representation == "hinge":
-            self.model.jnt_stiffness[self.joint_ids] = self._k_bend * f
-        if self._dof_damping_bend is not None:
-            np.multiply(self._d0_bend, f, out=self._dof_damping_bend)
-        else:
-            self.model.dof_damping[self.bend_dof] = self._d0[self.bend_dof] * f
+        self._stiffness_in_model = self.view.set_stiffness(self._k_bend, f)
+        self.view.scale_damping(f)
 
     def set_hinge_parameters(self, stiffness=None, damping=None) -> None:
         """Set every hinge's bending stiffness (N m / rad) and/or viscous damping (N m s / rad),
@@ -225,7 +388,7 @@ class ActuatorPart:
         seed 001's model; see :mod:`mjeap.identify`). Hinge chain only. The timestep is not
         re-chosen: a stiffer, less damped chain than the model was built for can diverge
         (the step then raises :class:`DivergenceError`)."""
-        if self.representation != "hinge":
+        if not self.builder.per_hinge_parameters:
             raise ParameterError("representation", self.representation,
                                  "'hinge' (per-joint stiffness and damping are a hinge-chain notion)")
         n = self.layout.segments
@@ -235,13 +398,13 @@ class ActuatorPart:
             if not np.all(np.isfinite(k) & (k > 0)):
                 raise ParameterError("stiffness", stiffness, "positive finite values in N m/rad")
             self._k_bend = k / self.units.rotational_stiffness
-            self.model.jnt_stiffness[self.joint_ids] = self._k_bend * self._stiffness_scale
+            self.view.set_stiffness(self._k_bend, self._stiffness_scale)
         if damping is not None:
             b = np.broadcast_to(np.asarray(damping, float), (n,))
             if not np.all(np.isfinite(b) & (b >= 0)):
                 raise ParameterError("damping", damping, "finite values >= 0 in N m s/rad")
-            self._d0[self.bend_dof] = b / self.units.rotational_damping
-            self.model.dof_damping[self.bend_dof] = self._d0[self.bend_dof] * self._stiffness_scale
+            self.view.set_damping(b / self.units.rotational_damping)
+            self.view.scale_damping(self._stiffness_scale)
 
     # ------------------------------------------------------------------ tip loads
     def set_tip_force(self, force: Union[float, Sequence[float]]) -> None:

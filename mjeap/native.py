@@ -16,9 +16,9 @@ viewer (the voltage is a slider), in ``mujoco.rollout`` and in batched engines:
 Conventions every generated model follows: the custom numeric ``mjeap_units`` holds
 "L M T", the SI size of one internal length, mass and time unit; the beam's names are as
 a :class:`mjeap.Scene` builds them (``clamp`` body, ``tip`` site, ``hinge<j>`` joints),
-prefixed per actuator when several share a model. The cable representation's ball joints
-cannot be summed by a fixed tendon: it has no native form and runs on the loop or
-threaded engine.
+prefixed per actuator when several share a model. A representation without bending joints
+to sum has no native form (its builder's ``native_reason``: the cable's ball joints, the
+rod's vertices) and runs on the loop (or threaded) engine.
 """
 from __future__ import annotations
 
@@ -145,9 +145,8 @@ def why_not(scene, drive, controller=None) -> Optional[str]:
     """None where the native engine applies to this run of ``scene``; else why not."""
     if controller is not None:
         return "a controller closes the loop (its voltage depends on the state)"
-    if scene.representation != "hinge":
-        return (f"the {scene.representation} representation's ball joints cannot be summed by a fixed tendon "
-                "(the native drives act on the hinge chain)")
+    if scene.builder.native_reason is not None:
+        return scene.builder.native_reason
     reason = drive.native_reason()
     if reason is not None:
         return f"the {drive.name} drive has no native form: {reason}"

@@ -252,6 +252,10 @@ def attach(spec: mujoco.MjSpec, actuator, *, prefix: str, site: Optional[str] = 
                              f"standard gravity along -z, 0 0 {-9.80665 / units.acceleration:.9g} in these units "
                              "(9.81 m/s^2), or none: the actuator's damping and timestep are chosen for it "
                              "(a host in other units: declare them with units=)")
+    from .mjcf import get_builder
+    why = get_builder(representation).attach_reason
+    if why is not None:
+        raise ParameterError("representation", representation, "'hinge' (or 'cable' on MuJoCo 3.x) for attach", why)
     R = _mount_rotation(spec, kind, name, el)
     twin = Scene(actuator, representation=representation, segments=segments, orientation=R, payload=payload,
                  units=units, damping_ratio=damping_ratio, gravity=bool(np.any(g)), integrator=integrator)
@@ -395,7 +399,7 @@ class System:
             self.timestep_reason = "given by the user"
         self.spec = spec
         for a in self.actuators:
-            if a.twin.integrator == "discrete" and a.twin.representation == "hinge":
+            if a.twin.builder.implicit_stiffness(a.twin.integrator):
                 # discrete damps the beam by h K itself: the joints carry beta - h of the system's h
                 for name, b in zip(a.joints, a.twin.joint_damping(h)):
                     spec.joint(name).damping = [float(b), 0.0, 0.0]
