@@ -48,6 +48,9 @@ class BeamView:
     carries each hinge's bending (None where no dof does, e.g. the rod's vertices)."""
 
     bend_dof: Optional[np.ndarray] = None
+    #: the generalised force of a hinge moment depends on the configuration (the rod's
+    #: vertex forces follow its edges): moments must be applied again before every step
+    moments_follow_geometry: bool = False
 
     def bind(self, data: mujoco.MjData) -> None:
         """Views of ``data`` for the per-step paths (made once per MjData)."""
@@ -366,6 +369,21 @@ class ActuatorPart:
             # a model whose stiffness is fixed at init (the cable plugin): add the change as a moment
             change = (self._stiffness_scale - 1.0) * self._k_bend
         self.view.apply_moments(moments, self._inv_moment, change)
+        if self.view.moments_follow_geometry:
+            self._moments = np.array(moments, dtype=float)
+
+    #: the last internal moments (N m) where they must follow the geometry, else None
+    _moments = None
+
+    def forget_moments(self) -> None:
+        """The model's applied forces were cleared (mj_resetData): no moments to apply again."""
+        self._moments = None
+
+    def reapply_moments(self) -> None:
+        """Apply the last internal moments again at the present configuration (a beam whose
+        moments follow its geometry, before each step; the drives set them every step)."""
+        if self._moments is not None:
+            self.set_internal_moments(self._moments)
 
     #: whether the model's own stiffness follows set_bending_stiffness_scale (else the
     #: change is applied as a moment with the drives' moments)

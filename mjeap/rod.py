@@ -4,7 +4,7 @@ rod (the replacement of the cable plugin and ``<composite>``, removed in MuJoCo 
 What is built (internal units, :mod:`mjeap.mjcf` conventions)::
 
     <flexcomp name="rod" type="direct" dim="1" point="..." radius="t/2">
-      <elasticity young="E" poisson="nu" damping="beta - h" section="box" sectionsize="t/2 w/2"/>
+      <elasticity young="E" poisson="nu" damping="(beta - h) t/w" section="box" sectionsize="t/2 w/2"/>
       <edge equality="true" solref="h/100 1" solimp="0.9999 ..."/>
       <pin id="0 1"/>
     </flexcomp>
@@ -53,10 +53,12 @@ What is built (internal units, :mod:`mjeap.mjcf` conventions)::
   ``implicitfast``; ``discrete`` integrates it implicitly (as backward Euler does the hinge
   chain's springs), so the rod has no stability limit of its own and the scene steps it at
   min(T_1 / 50, beta / 2) like the hinge chain under ``discrete``.
-* **Damping.** The flex's own Rayleigh damping (``elasticity damping``, D = coefficient x
-  the bending stiffness, twist included): the file is self-contained. Backward Euler damps
-  each mode by omega h / 2 itself (beta = h), so the coefficient is beta - h with beta from
-  the scene's first mode (:mod:`mjeap.scene`).
+* **Damping.** The flex's own Rayleigh damping (``elasticity damping``): the file is
+  self-contained. MuJoCo damps a box section's weak axis by coefficient x sqrt(k1 k2), the
+  strong one by coefficient x k2 (equal damping ratios), so the coefficient is
+  (beta - h) t / w: bending then gets (beta - h) x its stiffness, and backward Euler adds
+  h x its stiffness itself (Rayleigh beta = h), beta from the scene's first mode
+  (:mod:`mjeap.scene`).
 * **Read-outs** (:class:`RodView`): the bending angle at vertex j is the turn between its
   two edges, in the clamp's x-y plane, from the vertex positions (the slides are offsets in
   the clamp frame); rates from their velocities. A drive's internal moment M_j acts as
@@ -203,7 +205,9 @@ class RodBuilder(BeamBuilder):
         flex.vert = v
         spec.delete(spec.body(f"{n}_{N + 1}"))      # after the flex no longer names it
         links = [f"{n}_{k}" for k in range(1, N + 1)]
-        return BeamHandles("rod", links, [], tip_body=f"{n}_tip", extra={"flex": n, "tip_joint": f"{n}_tip"})
+        _, t, w = self._section(layout)
+        return BeamHandles("rod", links, [], tip_body=f"{n}_tip",
+                           extra={"flex": n, "tip_joint": f"{n}_tip", "aspect": t / w})
 
     def payload_host(self, layout, handles, payload):
         j = layout.link_containing(min(payload.position, layout.length))
@@ -215,8 +219,11 @@ class RodBuilder(BeamBuilder):
         return handles.tip_body
 
     def set_damping(self, spec, handles, beta, per_hinge, dof_damping=None):
-        # Rayleigh damping of the flex itself: D = coefficient x its bending (and twist) stiffness
-        spec.flex(handles.extra["flex"]).damping = float(beta)
+        # the flex's own Rayleigh damping. MuJoCo 4.0 damps a box section's weak axis with
+        # coefficient x sqrt(k1 k2) (the strong axis with coefficient x k2), equalising the
+        # damping ratios of the two axes: with k1 / k2 = (t / w)^2 the coefficient that gives
+        # the weak (bending) axis beta k1 is beta t / w
+        spec.flex(handles.extra["flex"]).damping = float(beta) * handles.extra["aspect"]
 
     def finish(self, spec, handles, timestep):
         # the edge constraints' time constant, EDGE_TIMECONST x h
@@ -274,6 +281,8 @@ class RodView(BeamView):
     vertex bodies are offsets in the clamp frame; the last edge is the tip frame, its
     direction the tip hinge's angle), moments as forces on its vertices and a torque on the
     tip frame."""
+
+    moments_follow_geometry = True
 
     def __init__(self, model: mujoco.MjModel, handles: BeamHandles, layout: BeamLayout, units: UnitSystem,
                  prefix: str, find, name: str = "rod"):
@@ -403,8 +412,9 @@ class RodView(BeamView):
         return True
 
     def damping(self):
-        k1 = self.model.flex_bending[self._k_idx[::2]]
-        return self.model.flex_damping[self.flex] * 2.0 * k1   # hinge equivalent: 2 k1 per vertex
+        # the weak axis: coefficient x sqrt(k1 k2), hinge equivalent 2 x that per vertex
+        k1, dk = self.model.flex_bending[self._k_idx[::2]], self.model.flex_bending[self._k_idx[1::2]]
+        return self.model.flex_damping[self.flex] * 2.0 * np.sqrt(k1 * (k1 + dk))
 
     def scale_damping(self, factor):
         # the flex's damping is its coefficient x its stiffness: it follows set_stiffness

@@ -385,6 +385,7 @@ class Scene:
         """Reset to rest; ``curvature`` (1/m) starts the beam as a uniform arc of that
         curvature (seed 000 starts each experiment from a measured curvature)."""
         mujoco.mj_resetData(self.model, self.data)
+        self.part.forget_moments()           # mj_resetData clears qfrc_applied
         self.part.apply_loads()              # mj_resetData clears xfrc_applied; tip loads persist
         self.part.set_bending_stiffness_scale(1.0)
         if curvature:
@@ -394,8 +395,15 @@ class Scene:
 
     # ------------------------------------------------------------------ stepping
     def step(self, n: int = 1) -> None:
-        """Advance ``n`` steps; raises :class:`DivergenceError` if the state blows up."""
-        mujoco.mj_step(self.model, self.data, nstep=n)
+        """Advance ``n`` steps; raises :class:`DivergenceError` if the state blows up. Internal
+        moments set on a beam whose moments follow its geometry (the rod) are applied again
+        at each step's configuration."""
+        if self.part._moments is not None:
+            for _ in range(n):
+                self.part.reapply_moments()
+                mujoco.mj_step(self.model, self.data)
+        else:
+            mujoco.mj_step(self.model, self.data, nstep=n)
         self._step_count += n
         self.check_finite()
         self.update_kinematics()

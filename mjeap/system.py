@@ -238,6 +238,10 @@ def attach(spec: mujoco.MjSpec, actuator, *, prefix: str, site: Optional[str] = 
     gravity; springs or dampers switched off (and actuation, for a driven beam) are refused.
     With ``contact`` the beam's own parts (its payload, neighbouring links) never touch."""
     units = units or DEFAULT_UNITS
+    from .mjcf import get_builder
+    why = get_builder(representation).attach_reason
+    if why is not None:
+        raise ParameterError("representation", representation, "'hinge' (or 'cable' on MuJoCo 3.x) for attach", why)
     integrator = integrator or ("discrete" if contact else "implicitfast")
     if not isinstance(prefix, str) or not _PREFIX.match(prefix):
         raise ParameterError("prefix", prefix, "a name of letters, digits, '_' or '-', starting with a letter")
@@ -252,10 +256,6 @@ def attach(spec: mujoco.MjSpec, actuator, *, prefix: str, site: Optional[str] = 
                              f"standard gravity along -z, 0 0 {-9.80665 / units.acceleration:.9g} in these units "
                              "(9.81 m/s^2), or none: the actuator's damping and timestep are chosen for it "
                              "(a host in other units: declare them with units=)")
-    from .mjcf import get_builder
-    why = get_builder(representation).attach_reason
-    if why is not None:
-        raise ParameterError("representation", representation, "'hinge' (or 'cable' on MuJoCo 3.x) for attach", why)
     R = _mount_rotation(spec, kind, name, el)
     twin = Scene(actuator, representation=representation, segments=segments, orientation=R, payload=payload,
                  units=units, damping_ratio=damping_ratio, gravity=bool(np.any(g)), integrator=integrator)
