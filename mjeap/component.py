@@ -28,6 +28,14 @@ def as_slice(idx: np.ndarray):
     return idx
 
 
+def into(a: np.ndarray, out: Optional[np.ndarray]) -> np.ndarray:
+    """``a``, or ``a`` copied into ``out`` when given (the read-outs' ``out=`` convention)."""
+    if out is None:
+        return a
+    np.copyto(out, a)
+    return out
+
+
 def write_hinge_angles(qpos: np.ndarray, qposadr: np.ndarray, angles, hinge: bool) -> None:
     """Write bending angles (rad) about the local z axis into ``qpos``: hinge joints take
     the angle, ball joints (cable) the quaternion of that rotation."""
@@ -191,15 +199,8 @@ class HingeView(JointView):
 
     def angles(self, out=None):
         if self._qpos_bend is not None:
-            if out is None:
-                return self._qpos_bend.copy()
-            np.copyto(out, self._qpos_bend)
-            return out
-        a = self.data.qpos[self.joint_qpos]          # indexed fallback (copies)
-        if out is None:
-            return a
-        np.copyto(out, a)
-        return out
+            return self._qpos_bend.copy() if out is None else into(self._qpos_bend, out)
+        return into(self.data.qpos[self.joint_qpos], out)      # indexed fallback (copies)
 
     def write_angles(self, qpos, angles):
         write_hinge_angles(qpos, self.joint_qpos, angles, True)
@@ -237,11 +238,7 @@ class CableView(JointView):
             a *= 2.0
             return a
         q = self.data.qpos                         # indexed fallback (copies)
-        a = 2 * np.arctan2(q[self.joint_qpos + 3], q[self.joint_qpos])
-        if out is None:
-            return a
-        np.copyto(out, a)
-        return out
+        return into(2 * np.arctan2(q[self.joint_qpos + 3], q[self.joint_qpos]), out)
 
     def write_angles(self, qpos, angles):
         write_hinge_angles(qpos, self.joint_qpos, angles, False)

@@ -90,7 +90,7 @@ from typing import Optional
 import mujoco
 import numpy as np
 
-from .component import BeamView
+from .component import BeamView, into
 from .discretize import BeamLayout
 from .errors import ParameterError
 from .mjcf import BEAM_RGBA, BeamBuilder, BeamHandles, _finder, _set_inertial, register
@@ -334,11 +334,7 @@ class RodView(BeamView):
         e, _ = self._edges(self.positions(self.data.qpos))
         phi = np.arctan2(e[:, 1], e[:, 0])
         a = np.diff(phi)
-        a = (a + np.pi) % (2 * np.pi) - np.pi
-        if out is None:
-            return a
-        np.copyto(out, a)
-        return out
+        return into((a + np.pi) % (2 * np.pi) - np.pi, out)
 
     def rates(self, out=None):
         e, l2 = self._edges(self.positions(self.data.qpos))

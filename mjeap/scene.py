@@ -23,7 +23,13 @@ Damping and timestep are derived from the compiled model, never tuned by hand:
    chain therefore gets joint damping (beta - h) k, so that the first mode's damping ratio
    is still zeta_1, and its timestep is at most beta / 2 (the joint keeps at least half).
    ``discrete`` also solves contacts in the metric M + hD + h^2 K of the implicit update:
-   systems with contact need it (:mod:`mjeap.system`).
+   systems with contact need it (:mod:`mjeap.system`). The rod (:mod:`mjeap.rod`) runs
+   under ``discrete`` only (MuJoCo 4.0 refuses rod elasticity under the implicit
+   integrators), which takes its elasticity implicitly as it does the hinge springs: no
+   stability limit, the flex's own Rayleigh damping gives it (beta - h) K and its
+   timestep is at most beta / 2. Its modes are those of its bending angles
+   (:meth:`mjeap.rod.RodBuilder.linearize`). Which of these apply to a beam is its
+   builder's to say (:class:`mjeap.mjcf.BeamBuilder`).
 4. The default timestep is min(T_1 / 50, T_el / 50, h_stab / 2): 50 steps per period of
    the first mode keeps its period error below 0.1 %; T_el bounds it near the buckling load,
    where T_1 grows without bound but the beam's elastic response to a drive does not; the
