@@ -20,8 +20,8 @@ What is built (internal units, :mod:`mjeap.mjcf` conventions)::
   tip: the beam ends at its midpoint, where the tip site is. (With the last point at the tip
   the last vertex would represent 0.75 ds, a first-order error of ds / 4L in the tip angle
   under a uniform moment.) The curvature measure 2 tan(theta / 2) stiffens a vertex by
-  theta^2 / 3 relative to the hinge chain's exact angle: a second-order error, 0.3 % at
-  a tip angle of 2 rad on 20 segments.
+  theta^2 / 3 relative to the hinge chain's exact angle: a second-order error, -0.25 % of
+  the curvature at a tip angle of 2 rad and 0.2 % of L at P L^2 / EI = 10 on 20 segments.
 * **Section.** ``section="box"`` with half-sizes (t/2, w/2) and E = 12 EI / (w t^3), so the
   weak axis (bending in the clamp's x-y plane) carries the catalog's EI; the strong axis
   (E I (w/t)^2) and the torsion (G J) come with the box. ``radius`` is the minor half-size
@@ -48,7 +48,8 @@ What is built (internal units, :mod:`mjeap.mjcf` conventions)::
   on a jointed body: "flex with general attachments requires solver='CG'"), and then it
   blows up on its first steps (mjWARN_BADQACC, measured on 3.17.0): the rod is refused
   there. (A plain flexcomp rod without the tip frame does run on 3.17, with the same
-  bending statics as 4.0 but no twist joints and an isotropic box section.)
+  in-plane statics as 4.0 but no twist joints and one bending stiffness per vertex, the
+  weak axis's, where 4.0 has the box's two principal ones.)
 * **Integrator.** MuJoCo 4.0 refuses rod elasticity under ``implicit`` and
   ``implicitfast``; ``discrete`` integrates it implicitly (as backward Euler does the hinge
   chain's springs), so the rod has no stability limit of its own and the scene steps it at
@@ -63,8 +64,10 @@ What is built (internal units, :mod:`mjeap.mjcf` conventions)::
   two edges, in the clamp's x-y plane, from the vertex positions (the slides are offsets in
   the clamp frame); rates from their velocities. A drive's internal moment M_j acts as
   equal and opposite couples on the two edges at vertex j: edge k carries M_k - M_{k+1},
-  applied as forces +-C / l along the edge normal at its two vertices (the generalised
-  force of the hinge moments, as the cable's bending dofs take them).
+  applied as forces +-C / l along the edge normal at its two vertices (the last edge, the
+  tip frame: a torque on its hinge), the generalised force of the hinge moments, as the
+  cable's bending dofs take them. Those forces follow the edges, so moments set on a
+  scene are applied again before each step (the drives set theirs every step anyway).
 
 Refused on the rod, each with its reason (:class:`RodBuilder`):
 
@@ -78,9 +81,11 @@ Refused on the rod, each with its reason (:class:`RodBuilder`):
   moments. MuJoCo 4.0's flex offers no per-vertex bending coordinate.
 * ``engine="threaded"``: its moments are forces along the present edge normals, not fixed
   generalised forces that could be precomputed as ``qfrc_applied`` controls.
-* ``attach`` / :class:`~mjeap.System`: the flexcomp's per-edge twist bodies hang under the
-  world body and its flex and edge equality are model-level elements, which
-  ``MjSpec.attach`` of the clamp body does not carry.
+* ``attach`` / :class:`~mjeap.System`: ``MjSpec.attach`` of the clamp body carries the flex
+  but not the per-edge twist bodies, which the flexcomp puts under the world body; MuJoCo
+  then refuses the box-section rod ("1D flex elasticity with box section requires per-edge
+  twist joints", measured). Attaching the twist bodies to the host's world as well might
+  make it compile; not built.
 * accuracy targets (:mod:`mjeap.accuracy`): its error model is the hinge chain's.
 """
 from __future__ import annotations
@@ -126,8 +131,9 @@ class RodBuilder(BeamBuilder):
                        "forces that mujoco.rollout could take as qfrc_applied controls")
     accuracy_reason = ("no target on a 'rod' scene (give segments and timestep): the accuracy model is the hinge "
                        "chain's")
-    attach_reason = ("the rod's flexcomp puts its per-edge twist bodies under the world body and its flex and edge "
-                     "equality are model-level elements: MjSpec.attach of the clamp body does not carry them")
+    attach_reason = ("MjSpec.attach of the clamp body carries the rod's flex but not its per-edge twist bodies, which "
+                     "the flexcomp puts under the world body, and MuJoCo refuses a box-section rod without them "
+                     "('requires per-edge twist joints')")
 
     def unavailable_reason(self):
         from .versions import MUJOCO_VERSION, mujoco_major
