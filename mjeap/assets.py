@@ -1,5 +1,12 @@
-"""The generated MJCF files of ``assets/mjcf``: one per catalog actuator and representation,
-at the default discretisation, horizontal, unloaded."""
+"""The generated MJCF files of ``assets/mjcf``: one per catalog actuator and representation
+(that can build it), at the default discretisation, horizontal, unloaded.
+
+The hinge files hold everything (damping per joint). The rod files too: the flex's own
+Rayleigh damping (``elasticity damping``). The cable files do not: their Rayleigh damping
+differs per dof of a ball joint (bending, in-plane, twist: the in-plane stiffness is (w/t)^2
+the bending one), which MJCF cannot say (one damping per joint), so it travels in the
+custom numeric ``mjeap_dof_damping`` that :func:`mjeap.load_mjcf` applies; raw, the stiff
+undamped in-plane and twist dofs of the explicit cable plugin diverge at the file's step."""
 from __future__ import annotations
 
 import textwrap
@@ -40,7 +47,8 @@ def asset_xml(actuator_id: str, representation: str) -> str:
     else:
         spec = s.spec.copy()
         add_units(spec, s.units)
-        drive_note = f"Passive beam: {why}. Drive it with mjeap (loop or threaded engine)."
+        engines = "loop engine" if s.builder.threaded_reason else "loop or threaded engine"
+        drive_note = f"Passive beam: {why}. Drive it with mjeap ({engines})."
     add_viewing(spec, s)
     drive_note = "\n".join(textwrap.wrap(drive_note, 95, initial_indent=" " * 5, subsequent_indent=" " * 5)) + "\n"
     c = s.choice
@@ -55,7 +63,7 @@ def asset_xml(actuator_id: str, representation: str) -> str:
         + drive_note
         + ("     Per-dof damping is in the custom numeric 'mjeap_dof_damping': load with\n"
            "     mjeap.load_mjcf(path), which applies it (MJCF has one damping per ball joint).\n"
-           if representation != "hinge" else "")
+           if s.builder.stores_dof_damping else "")
         + "-->\n")
     return header + spec.to_xml()
 
@@ -83,16 +91,28 @@ def add_viewing(spec, scene: Scene) -> None:
 
 
 def iter_assets() -> Iterator[Tuple[str, str]]:
-    for aid in CATALOG:
+    """Every catalog actuator in every representation that can build it (the rod: beams of
+    one section; the tapered piezo bimorphs are hinge and cable only)."""
+    from .model.discretize import discretize
+    from .model.mjcf import BUILDERS
+    from .simulation.scene import DEFAULT_SEGMENTS
+    for aid, act in CATALOG.items():
+        layout = discretize(act, DEFAULT_SEGMENTS)
         for rep in REPRESENTATIONS:
-            yield aid, rep
+            if BUILDERS[rep].layout_reason(layout) is None:
+                yield aid, rep
 
 
 def write_assets(directory: Path = ASSET_DIR) -> Dict[str, Path]:
+    """Write the files of every representation this MuJoCo runs; the others (the cable on
+    4.x, the rod on 3.x) are left as they are: regenerate them under the other version."""
     from .io.outputs import replacing
+    from .model.mjcf import BUILDERS
     directory.mkdir(parents=True, exist_ok=True)
     out = {}
     for aid, rep in iter_assets():
+        if BUILDERS[rep].unavailable_reason() is not None:
+            continue
         p = directory / asset_name(aid, rep)
         with replacing(p) as tmp:
             tmp.write_text(asset_xml(aid, rep))

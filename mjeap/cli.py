@@ -232,7 +232,8 @@ def add_scene_args(p: argparse.ArgumentParser) -> None:
                    "(NdFeB sphere) or 12.6mg@6.27mm,point (no rotary inertia)")
     p.add_argument("--orientation", choices=ORIENTATIONS, default="horizontal")
     p.add_argument("--timestep", type=float, help="timestep in s (default: chosen from the model)")
-    p.add_argument("--integrator", choices=list(INTEGRATORS), default="implicitfast")
+    p.add_argument("--integrator", choices=list(INTEGRATORS), default=None,
+                   help="default: the representation's own (implicitfast; the rod: discrete)")
 
 
 def _value(text: str):

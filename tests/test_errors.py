@@ -27,7 +27,7 @@ def test_bad_scene_parameters(kwargs, name):
 
 def test_unknown_representation():
     with pytest.raises(UnknownNameError, match="representation"):
-        Scene("pedot-micro", representation="rod")
+        Scene("pedot-micro", representation="rods")
 
 
 @pytest.mark.parametrize("kwargs,name", [

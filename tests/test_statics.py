@@ -9,7 +9,7 @@ ACT = "pedot-micro"
 L, EI = 6e-3, 1 / 4.86e7
 
 
-@pytest.fixture(scope="module", params=["hinge", "cable"])
+@pytest.fixture(scope="module", params=["hinge", "cable", "rod"])
 def scene(request):
     return Scene(ACT, representation=request.param)
 
@@ -28,7 +28,8 @@ def test_tip_force_matches_elastica_within_1_percent(scene, load):
 
 @pytest.mark.parametrize("kl", [0.3, 1.2, 2.0])
 def test_tip_moment_bends_exact_arc(scene, kl):
-    """A tip couple M gives curvature M/EI; tip within 0.5 % of the exact arc."""
+    """A tip couple M gives curvature M/EI; tip within 0.5 % of the exact arc (the rod:
+    -0.25 % at kappa L = 2, its 2 tan(theta/2) curvature; the hinge chain +0.08 %)."""
     M = kl * EI / L
     tip = settled_tip(scene, moment=M)
     x, y, th = an.arc_tip_moment(M, L, EI)
@@ -36,9 +37,10 @@ def test_tip_moment_bends_exact_arc(scene, kl):
     assert scene.tip_curvature() == pytest.approx(kl / L, rel=0.005)
 
 
-@pytest.mark.parametrize("representation", ["hinge", "cable"])
+@pytest.mark.parametrize("representation", ["hinge", "cable", "rod"])
 def test_convergence_is_second_order(representation):
-    """Tip deflection error against the elastica (P L^2/EI = 1) falls as N^-2."""
+    """Tip deflection error against the elastica (P L^2/EI = 1) falls as N^-2 (measured:
+    hinge 2.001, rod 2.003)."""
     P = EI / L**2
     ref = an.elastica_tip_force(P, L, EI).tip[1]
     Ns = [4, 8, 16, 32]

@@ -27,8 +27,16 @@ def test_seed_000_heaviest_run_is_the_same_on_every_version():
 
 @on_4
 def test_cable_on_mujoco_4_is_refused_naming_the_alternative():
-    with pytest.raises(ParameterError, match=r"representation='cable'.*'hinge' on MuJoCo 4.*cable plugin"):
+    """The refusal names the rod, the cable's replacement (a 1D flexcomp rod, mjeap.rod)."""
+    with pytest.raises(ParameterError, match=r"representation='cable'.*'hinge' or 'rod' on MuJoCo 4.*cable plugin.*"
+                                             r"representation='rod'"):
         Scene("pedot-micro", representation="cable")
+
+
+@pytest.mark.skipif(not cable_available(), reason="MuJoCo 4.x: the rod runs here")
+def test_rod_on_mujoco_3_is_refused_naming_the_reason():
+    with pytest.raises(ParameterError, match=r"representation='rod'.*'hinge' or 'cable' on MuJoCo 3.*CG solver"):
+        Scene("pedot-micro", representation="rod")
 
 
 @on_4

@@ -16,9 +16,9 @@ viewer (the voltage is a slider), in ``mujoco.rollout`` and in batched engines:
 Conventions every generated model follows: the custom numeric ``mjeap_units`` holds
 "L M T", the SI size of one internal length, mass and time unit; the beam's names are as
 a :class:`mjeap.Scene` builds them (``clamp`` body, ``tip`` site, ``hinge<j>`` joints),
-prefixed per actuator when several share a model. The cable representation's ball joints
-cannot be summed by a fixed tendon: it has no native form and runs on the loop or
-threaded engine.
+prefixed per actuator when several share a model. A representation without bending joints
+to sum has no native form (its builder's ``native_reason``: the cable's ball joints, the
+rod's vertices) and runs on the loop (or threaded) engine.
 """
 from __future__ import annotations
 

@@ -17,9 +17,8 @@ def why_not(scene, drive, controller=None) -> Optional[str]:
     """None where the native engine applies to this run of ``scene``; else why not."""
     if controller is not None:
         return "a controller closes the loop (its voltage depends on the state)"
-    if scene.representation != "hinge":
-        return (f"the {scene.representation} representation's ball joints cannot be summed by a fixed tendon "
-                "(the native drives act on the hinge chain)")
+    if scene.builder.native_reason is not None:
+        return scene.builder.native_reason
     reason = drive.native_reason()
     if reason is not None:
         return f"the {drive.name} drive has no native form: {reason}"

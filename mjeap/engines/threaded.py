@@ -47,6 +47,8 @@ def why_not(scene, drive, controller=None) -> Optional[str]:
     """None where the threaded engine applies to this run; else the reason, in words."""
     if controller is not None:
         return "a controller closes the loop (its voltage depends on the state)"
+    if scene.builder.threaded_reason is not None:
+        return scene.builder.threaded_reason
     reason = drive.closed_loop_reason()
     if reason is not None:
         return f"the {drive.name} drive is not open-loop: {reason}"

@@ -10,16 +10,25 @@ Two representations sit behind one interface, :class:`BeamBuilder`:
   the geom's box section, divided by the distance to the previous body) and each body an
   explicit inertial.
 
-Both place their hinges by the midpoint rule of :mod:`mjeap.model.discretize`. Body frames: the
+* ``rod``: a 1D ``flexcomp`` rod (discrete elastic rod, MuJoCo's replacement of the cable),
+  in its own module, :mod:`mjeap.model.rod`.
+
+All place their hinges by the midpoint rule of :mod:`mjeap.model.discretize`. Body frames: the
 origin of link j is hinge j, local x runs along the beam, local y is the deflection
 (thickness) direction and local z the hinge (width) axis. Everything is written in the
-internal units of a :class:`~mjeap.units.UnitSystem`. A MuJoCo 4 backend (1D flexcomp rods)
-would be a third builder.
+internal units of a :class:`~mjeap.units.UnitSystem`.
+
+A builder owns everything that differs between representations, so that the rest of mjeap
+asks it and a new beam type is one module: what it builds, which integrators it runs under
+and whether they integrate its stiffness implicitly, how it is damped and linearised, which
+engines and features apply to it (each refusal with its reason), and, through its
+:class:`~mjeap.model.views.BeamView`, how its bending is read, set and driven in a compiled
+model.
 """
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Dict, List, Optional
+from typing import Dict, List, Optional, Tuple
 
 import mujoco
 import numpy as np
@@ -50,11 +59,49 @@ class BeamHandles:
 
 
 class BeamBuilder:
-    """Interface: add a discretised beam under the clamp body of a spec."""
+    """Interface: add a discretised beam under the clamp body of a spec, and say how it is
+    simulated, damped and read (see the module docstring)."""
 
     representation: str = ""
     #: generalised dofs per hinge (sizes the MjData arena)
     dofs_per_hinge: int = 1
+    #: the integrators it runs under, and the one a Scene takes when none is named
+    integrators: Tuple[str, ...] = ("implicitfast", "discrete")
+    default_integrator: str = "implicitfast"
+    #: per-dof damping travels in the custom numeric mjeap_dof_damping (mjeap.scene), applied
+    #: after compiling: MJCF has one damping per joint (the cable's ball joints)
+    stores_dof_damping: bool = False
+    #: the stability limit is also checked bent (Scene's max_bend): stiffness that couples
+    #: once bent (the cable)
+    check_bent_stability: bool = False
+    #: per-hinge stiffness and damping can be set (mjeap.identify)
+    per_hinge_parameters: bool = False
+    #: why a native drive (mjeap.native), the threaded engine, a run at an accuracy target,
+    #: attaching to a host (mjeap.system) do not apply (None: they do)
+    native_reason: Optional[str] = None
+    threaded_reason: Optional[str] = None
+    accuracy_reason: Optional[str] = None
+    attach_reason: Optional[str] = None
+
+    def unavailable_reason(self) -> Optional[str]:
+        """Why this MuJoCo cannot run the representation (None: it can)."""
+        return None
+
+    def layout_reason(self, layout: BeamLayout) -> Optional[str]:
+        """Why this beam cannot be built in the representation (None: it can)."""
+        return None
+
+    def integrator_reason(self, integrator: str) -> Optional[str]:
+        """Why ``integrator`` does not run the representation (None: it does)."""
+        if integrator in self.integrators:
+            return None
+        return f"the {self.representation} representation runs under {' or '.join(map(repr, self.integrators))}"
+
+    def implicit_stiffness(self, integrator: str) -> bool:
+        """Whether ``integrator`` integrates the beam's bending stiffness implicitly (backward
+        Euler: it then damps each mode by omega h / 2 itself, Rayleigh damping with beta = h,
+        and has no stability limit of its own)."""
+        return False
 
     def skeleton_xml(self, layout: BeamLayout, units: UnitSystem) -> str:
         """XML placed inside the clamp body before parsing (composites must be parsed)."""
@@ -65,6 +112,51 @@ class BeamBuilder:
 
     def build(self, spec: mujoco.MjSpec, layout: BeamLayout, units: UnitSystem) -> BeamHandles:
         raise NotImplementedError
+
+    def payload_host(self, layout: BeamLayout, handles: BeamHandles, payload: Payload) -> str:
+        """The body that carries ``payload`` (its frame's origin at link j's start)."""
+        return handles.link_bodies[layout.link_containing(min(payload.position, layout.length))]
+
+    def set_damping(self, spec: mujoco.MjSpec, handles: BeamHandles, beta: float, per_hinge: np.ndarray,
+                    dof_damping: Optional[np.ndarray] = None) -> None:
+        """Damp the beam (internal units): stiffness-proportional with coefficient ``beta``
+        (time), ``per_hinge`` the damping of each hinge that gives; ``dof_damping`` the
+        Rayleigh damping per dof of the whole model where the builder stores it."""
+        for name, b in zip(handles.joints, per_hinge):
+            spec.joint(name).damping = [b, 0, 0]
+
+    def finish(self, spec: mujoco.MjSpec, handles: BeamHandles, timestep: float) -> None:
+        """Last settings once the timestep (internal) is chosen."""
+
+    def linearize(self, model: mujoco.MjModel, handles: BeamHandles, layout: BeamLayout, units: UnitSystem,
+                  angles: Optional[np.ndarray] = None):
+        """Mass and stiffness matrices (:class:`mjeap.modes.Linearization`) in the beam's own
+        coordinates, at its reference configuration or bent by ``angles`` (rad per hinge)."""
+        from .modes import linearize
+        if angles is None:
+            return linearize(model)
+        q = model.qpos0.copy()
+        self.view(model, handles, layout, units).write_angles(q, angles)
+        return linearize(model, qpos=q)
+
+    def view(self, model: mujoco.MjModel, handles: BeamHandles, layout: BeamLayout, units: UnitSystem,
+             prefix: str = "", find=None):
+        """The :class:`~mjeap.model.views.BeamView` of this beam in a compiled model (names
+        prefixed by ``prefix``; ``find(kind, name)`` looks an element up, refusing a
+        missing one)."""
+        raise NotImplementedError
+
+
+def _finder(model, prefix, find):
+    if find is not None:
+        return find
+
+    def look(kind, name):
+        i = mujoco.mj_name2id(model, kind, prefix + name)
+        if i < 0:
+            raise UnknownNameError(kind.name[6:].lower(), prefix + name, [])
+        return i
+    return look
 
 
 def _mat2quat(R: np.ndarray) -> np.ndarray:
@@ -85,6 +177,16 @@ class HingeChainBuilder(BeamBuilder):
 
     representation = "hinge"
     dofs_per_hinge = 1
+    per_hinge_parameters = True
+
+    def implicit_stiffness(self, integrator):
+        # under 'discrete' the joint springs are implicit (backward Euler)
+        return integrator == "discrete"
+
+    def view(self, model, handles, layout, units, prefix="", find=None):
+        from .views import HingeView
+        look = _finder(model, prefix, find)
+        return HingeView(model, np.array([look(mujoco.mjtObj.mjOBJ_JOINT, n) for n in handles.joints], dtype=int))
 
     def build(self, spec, layout, units):
         parent = spec.body("clamp")
@@ -115,6 +217,30 @@ class CableBuilder(BeamBuilder):
     representation = "cable"
     dofs_per_hinge = 3          # ball joints
     prefix = "cable"
+    stores_dof_damping = True
+    check_bent_stability = True
+    native_reason = ("the cable representation's ball joints cannot be summed by a fixed tendon "
+                     "(the native drives act on the hinge chain)")
+    accuracy_reason = ("no target on a 'cable' scene (give segments and timestep): the accuracy model is the "
+                       "hinge chain's (order 2 in segments)")
+
+    def unavailable_reason(self):
+        from ..versions import MUJOCO_VERSION, cable_available
+        if cable_available():
+            return None
+        return (f"MuJoCo {MUJOCO_VERSION} removed the cable plugin and <composite>: use representation='rod' "
+                "(a 1D flexcomp rod, their replacement, mjeap.model.rod) or 'hinge'; the cable runs on MuJoCo 3.17")
+
+    def set_damping(self, spec, handles, beta, per_hinge, dof_damping=None):
+        super().set_damping(spec, handles, beta, per_hinge)
+        if dof_damping is not None:
+            from .fields import DOF_DAMPING_FIELD
+            spec.add_numeric(name=DOF_DAMPING_FIELD, data=list(dof_damping))
+
+    def view(self, model, handles, layout, units, prefix="", find=None):
+        from .views import CableView
+        look = _finder(model, prefix, find)
+        return CableView(model, np.array([look(mujoco.mjtObj.mjOBJ_JOINT, n) for n in handles.joints], dtype=int))
 
     def extensions_xml(self) -> str:
         return '<extension><plugin plugin="mujoco.elasticity.cable"/></extension>'
@@ -167,20 +293,41 @@ class CableBuilder(BeamBuilder):
 
 
 BUILDERS: Dict[str, BeamBuilder] = {"hinge": HingeChainBuilder(), "cable": CableBuilder()}
+
+
+def register(builder: BeamBuilder) -> BeamBuilder:
+    """Add a representation (its builder) to :data:`BUILDERS` (and its name to
+    :data:`REPRESENTATIONS`; ``mjeap.model`` imports every builder's module before anyone
+    reads it)."""
+    global REPRESENTATIONS
+    BUILDERS[builder.representation] = builder
+    REPRESENTATIONS = tuple(BUILDERS)
+    return builder
+
+
+#: the representations' names, in the order they were registered
 REPRESENTATIONS = tuple(BUILDERS)
 
 
-def get_builder(representation: str) -> BeamBuilder:
+def get_builder(representation: str, layout: Optional[BeamLayout] = None) -> BeamBuilder:
+    """The builder of ``representation``, refused where this MuJoCo cannot run it (or, given
+    ``layout``, where that beam cannot be built in it), naming the alternative."""
     try:
         builder = BUILDERS[representation]
     except KeyError:
         raise UnknownNameError("representation", str(representation), BUILDERS) from None
-    from ..versions import MUJOCO_VERSION, cable_available
-    if representation == "cable" and not cable_available():
-        raise ParameterError("representation", representation, "'hinge' on MuJoCo 4.x",
-                             f"MuJoCo {MUJOCO_VERSION} removed the cable plugin and <composite> (1D flexcomp rods "
-                             "replace them; mjeap's rod representation is not built yet); the cable runs on MuJoCo "
-                             "3.17")
+    why = builder.unavailable_reason()
+    if why is not None:
+        from ..versions import MUJOCO_VERSION
+        ok = [r for r, b in BUILDERS.items() if b.unavailable_reason() is None]
+        raise ParameterError("representation", representation,
+                             f"{' or '.join(map(repr, ok))} on MuJoCo {MUJOCO_VERSION}", why)
+    if layout is not None:
+        why = builder.layout_reason(layout)
+        if why is not None:
+            raise ParameterError("representation", representation,
+                                 "'hinge' for this beam" if representation != "hinge" else "another representation",
+                                 f"{layout.actuator_id}: {why}")
     return builder
 
 
@@ -201,7 +348,7 @@ def build_spec(layout: BeamLayout, representation: str = "hinge", orientation: s
     them from the compiled model.
     """
     units = units or UnitSystem()
-    builder = get_builder(representation)
+    builder = get_builder(representation, layout)
     R = clamp_rotation(orientation)
     quat = " ".join(f"{v:.12g}" for v in _mat2quat(R))
     L = layout.length / units.length
@@ -242,7 +389,7 @@ def build_spec(layout: BeamLayout, representation: str = "hinge", orientation: s
                       block_inertia(m, layout.extension_length, layout.thickness, layout.link_width[-1]), units)
     if payload is not None:
         j = layout.link_containing(min(payload.position, layout.length))
-        host = spec.body(handles.link_bodies[j])
+        host = spec.body(builder.payload_host(layout, handles, payload))
         r = payload.sphere_radius
         pb = host.add_body(name="payload", pos=[(payload.position - layout.link_start[j]) / units.length, 0, 0])
         pb.add_geom(name="payload", type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[r / units.length, 0, 0],

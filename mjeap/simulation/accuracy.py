@@ -290,9 +290,8 @@ def run_at_accuracy(scene, run, *, accuracy: float, duration: float, wave=None,
     the chosen model, report dict), the report also put in each result's
     ``meta['accuracy']``."""
     target = check_accuracy(accuracy)
-    if scene.representation != "hinge":
-        raise ParameterError("accuracy", accuracy, "no target on a 'cable' scene (give segments and timestep): the "
-                             "accuracy model is the hinge chain's (order 2 in segments)")
+    if scene.builder.accuracy_reason is not None:
+        raise ParameterError("accuracy", accuracy, scene.builder.accuracy_reason)
     t0 = _time.perf_counter()
     grid = _grid(duration, sample_interval)
     h_cap = _step_cap(scene, wave, grid)

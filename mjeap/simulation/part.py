@@ -16,29 +16,10 @@ from typing import Optional, Sequence, Union
 import mujoco
 import numpy as np
 
-from ..model import analytical
 from ..errors import ParameterError, check_positive
-
-
-def as_slice(idx: np.ndarray):
-    """A slice equal to an evenly spaced index array (else the array itself)."""
-    idx = np.asarray(idx)
-    if len(idx) > 1 and np.all(np.diff(idx) == idx[1] - idx[0]) and idx[1] > idx[0]:
-        return slice(int(idx[0]), int(idx[-1]) + 1, int(idx[1] - idx[0]))
-    return idx
-
-
-def write_hinge_angles(qpos: np.ndarray, qposadr: np.ndarray, angles, hinge: bool) -> None:
-    """Write bending angles (rad) about the local z axis into ``qpos``: hinge joints take
-    the angle, ball joints (cable) the quaternion of that rotation."""
-    if hinge:
-        qpos[qposadr] = angles
-    else:
-        half = 0.5 * np.asarray(angles, dtype=float)
-        qpos[qposadr] = np.cos(half)
-        qpos[qposadr + 1] = 0.0
-        qpos[qposadr + 2] = 0.0
-        qpos[qposadr + 3] = np.sin(half)
+from ..model import analytical
+from ..model.mjcf import BUILDERS
+from ..model.views import BeamView, as_slice, into, write_hinge_angles  # noqa: F401  (public here before)
 
 
 class ActuatorPart:
@@ -62,32 +43,21 @@ class ActuatorPart:
 
         body = lambda n: find(mujoco.mjtObj.mjOBJ_BODY, n)  # noqa: E731
         h = handles
+        #: the beam's representation (:class:`mjeap.mjcf.BeamBuilder`): how its bending is
+        #: read, set and driven in this model (its :class:`BeamView`)
+        self.builder = BUILDERS[representation]
         self.clamp_id = body(h.clamp_body)
         self.link_ids = np.array([body(n) for n in h.link_bodies])
         self.tip_body_id = body(h.tip_body)
         self.tip_site_id = find(mujoco.mjtObj.mjOBJ_SITE, h.tip_site)
         self.payload_id = body(h.payload_body) if h.payload_body else -1
         self.tip_load_id = body(h.tip_load_body)
-        self.joint_ids = np.array([find(mujoco.mjtObj.mjOBJ_JOINT, n) for n in h.joints])
-        self.joint_qpos = m.jnt_qposadr[self.joint_ids]
-        self.joint_dof = m.jnt_dofadr[self.joint_ids]
-        # the bending dof of each hinge: the hinge itself, or a ball joint's rotation about
-        # the local z (hinge) axis
-        self.bend_dof = self.joint_dof + (0 if representation == "hinge" else 2)
-        # the same as slices (views, no copies) when evenly spaced, for the per-step paths
-        self._bend_sl = as_slice(self.bend_dof)
-        self._qpos_sl = as_slice(self.joint_qpos) if representation == "hinge" else None
-        # a ball joint's bending angle is 2 atan2(q_z, q_w) of its quaternion
-        self._quat_sl = None if representation == "hinge" else \
-            (as_slice(self.joint_qpos), as_slice(self.joint_qpos + 3))
+        self.joint_ids = np.array([find(mujoco.mjtObj.mjOBJ_JOINT, n) for n in h.joints], dtype=int)
+        self.view = self.builder.view(m, h, layout, units, prefix, find)
+        #: the generalised dof carrying each hinge's bending (None where none does: the rod)
+        self.bend_dof = self.view.bend_dof
         self._inv_moment = 1.0 / units.moment
         self._k_bend = layout.hinge_stiffness / units.rotational_stiffness  # internal units
-        self._d0 = m.dof_damping.copy()
-        jsl = as_slice(self.joint_ids)
-        self._jnt_stiffness_bend = m.jnt_stiffness[jsl] \
-            if isinstance(jsl, slice) and representation == "hinge" else None
-        self._dof_damping_bend = m.dof_damping[self._bend_sl] if isinstance(self._bend_sl, slice) else None
-        self._d0_bend = self._d0[self._bend_sl]
         self._stiffness_scale = 1.0
         self._fixed_rotation = None if rotation is None else np.asarray(rotation, dtype=float)
         self._tip_force_world = np.zeros(3)
@@ -102,17 +72,10 @@ class ActuatorPart:
         return self._data
 
     def bind(self, data: mujoco.MjData) -> None:
-        """Views (no copies) of the bending dofs in qpos, qvel and qfrc_applied, made once,
-        so the per-step paths of the drives allocate nothing; None where the dofs are not
-        evenly spaced (the indexed fallback then copies)."""
-        self._data = d = data
-        sl = self._bend_sl
-        strided = isinstance(sl, slice)
-        self._qfrc_bend = d.qfrc_applied[sl] if strided else None
-        self._qvel_bend = d.qvel[sl] if strided else None
-        self._qpos_bend = d.qpos[self._qpos_sl] if isinstance(self._qpos_sl, slice) else None
-        self._quat_wz = tuple(d.qpos[q] for q in self._quat_sl) \
-            if self._quat_sl is not None and all(isinstance(q, slice) for q in self._quat_sl) else None
+        """Bind the part (and its beam view, whose per-step paths then allocate nothing)
+        to ``data``."""
+        self._data = data
+        self.view.bind(data)
         self.apply_loads()
 
     @property
@@ -131,55 +94,36 @@ class ActuatorPart:
         a = np.asarray(angles, dtype=float)
         if a.shape != (self.layout.segments,):
             raise ParameterError("angles", a.shape, f"an array of {self.layout.segments} angles")
-        write_hinge_angles(self._data.qpos, self.joint_qpos, a, self.representation == "hinge")
-        self._data.qvel[self.joint_dof] = 0
-        if self.representation != "hinge":
-            self._data.qvel[self.joint_dof + 1] = 0
-            self._data.qvel[self.joint_dof + 2] = 0
+        self.view.write_angles(self._data.qpos, a)
+        self.view.zero_rates(self._data.qvel)
         if forward:
             mujoco.mj_forward(self.model, self._data)
 
     def hinge_angles(self, out: Optional[np.ndarray] = None) -> np.ndarray:
         """Bending angle (rad) of every hinge about the hinge axis; written into ``out``
         (shape (segments,)) when given, which then allocates nothing."""
-        if self._qpos_bend is not None:            # hinge chain
-            if out is None:
-                return self._qpos_bend.copy()
-            np.copyto(out, self._qpos_bend)
-            return out
-        if self._quat_wz is not None:              # cable: 2 atan2(q_z, q_w)
-            a = np.arctan2(self._quat_wz[1], self._quat_wz[0], out=out)
-            a *= 2.0
-            return a
-        q = self._data.qpos                        # indexed fallback (copies)
-        a = q[self.joint_qpos] if self.representation == "hinge" else \
-            2 * np.arctan2(q[self.joint_qpos + 3], q[self.joint_qpos])
-        if out is None:
-            return a
-        np.copyto(out, a)
-        return out
+        return self.view.angles(out)
 
     def hinge_rates(self, out: Optional[np.ndarray] = None) -> np.ndarray:
         """Bending angular velocity of every hinge (rad/s); written into ``out`` when given."""
-        v = self._qvel_bend if self._qvel_bend is not None else self._data.qvel[self._bend_sl]
-        return np.multiply(v, 1.0 / self.units.time, out=out)
+        return np.multiply(self.view.rates(), 1.0 / self.units.time, out=out)
 
     def hinge_stiffness(self) -> np.ndarray:
         """Current (instantaneous) bending stiffness of every hinge (N m / rad)."""
         return self._k_bend * self.units.rotational_stiffness * self._stiffness_scale
 
     def hinge_damping(self) -> np.ndarray:
-        """Current viscous damping of every hinge's bending dof (N m s / rad)."""
-        return self.model.dof_damping[self.bend_dof] * self.units.rotational_damping
+        """Current viscous damping of every hinge's bending (N m s / rad)."""
+        return self.view.damping() * self.units.rotational_damping
 
     def gravity_moments(self) -> np.ndarray:
-        """Moment (N m) that gravity exerts on every hinge's bending dof at the current
+        """Moment (N m) that gravity exerts on every hinge's bending at the current
         configuration (at rest)."""
         d = self._data
         saved = d.qvel.copy()
         d.qvel[:] = 0
         mujoco.mj_forward(self.model, d)
-        out = -d.qfrc_bias[self.bend_dof] * self.units.moment
+        out = -self.view.moments_of(d.qfrc_bias) * self.units.moment
         d.qvel[:] = saved
         mujoco.mj_forward(self.model, d)
         return out
@@ -187,20 +131,32 @@ class ActuatorPart:
     # ------------------------------------------------------------------ forces
     def set_internal_moments(self, moments) -> None:
         """Internal bending moment (N m) at every hinge (scalar: the same everywhere), applied
-        as equal and opposite couples on the two links it joins, i.e. a generalised force
-        on the hinge's bending dof. Replaces the previous call's moments."""
-        if self._stiffness_scale != 1.0 and self.representation != "hinge":
-            # the cable plugin's stiffness is fixed at init: add the change as a moment
-            M = np.multiply(moments, self._inv_moment)
-            M = M - (self._stiffness_scale - 1.0) * self._k_bend * self.hinge_angles()
-            self._data.qfrc_applied[self._bend_sl] = M
-        elif self._qfrc_bend is not None:   # the per-step path: no allocation
-            if isinstance(moments, np.ndarray) and moments.ndim:
-                np.multiply(moments, self._inv_moment, out=self._qfrc_bend)
-            else:
-                self._qfrc_bend.fill(float(moments) * self._inv_moment)
-        else:
-            self._data.qfrc_applied[self._bend_sl] = np.multiply(moments, self._inv_moment)
+        as equal and opposite couples on the two parts it joins (a generalised force on the
+        hinge's bending). Replaces the previous call's moments."""
+        change = None
+        if self._stiffness_scale != 1.0 and not self._stiffness_in_model:
+            # a model whose stiffness is fixed at init (the cable plugin): add the change as a moment
+            change = (self._stiffness_scale - 1.0) * self._k_bend
+        self.view.apply_moments(moments, self._inv_moment, change)
+        if self.view.moments_follow_geometry:
+            self._moments = np.array(moments, dtype=float)
+
+    #: the last internal moments (N m) where they must follow the geometry, else None
+    _moments = None
+
+    def forget_moments(self) -> None:
+        """The model's applied forces were cleared (mj_resetData): no moments to apply again."""
+        self._moments = None
+
+    def reapply_moments(self) -> None:
+        """Apply the last internal moments again at the present configuration (a beam whose
+        moments follow its geometry, before each step; the drives set them every step)."""
+        if self._moments is not None:
+            self.set_internal_moments(self._moments)
+
+    #: whether the model's own stiffness follows set_bending_stiffness_scale (else the
+    #: change is applied as a moment with the drives' moments)
+    _stiffness_in_model = True
 
     def set_bending_stiffness_scale(self, factor: float) -> None:
         """Scale every hinge's bending stiffness (and its Rayleigh damping, which keeps the
@@ -210,14 +166,8 @@ class ActuatorPart:
             return
         f = check_positive("stiffness factor", factor)
         self._stiffness_scale = f
-        if self._jnt_stiffness_bend is not None:
-            np.multiply(self._k_bend, f, out=self._jnt_stiffness_bend)
-        elif self.representation == "hinge":
-            self.model.jnt_stiffness[self.joint_ids] = self._k_bend * f
-        if self._dof_damping_bend is not None:
-            np.multiply(self._d0_bend, f, out=self._dof_damping_bend)
-        else:
-            self.model.dof_damping[self.bend_dof] = self._d0[self.bend_dof] * f
+        self._stiffness_in_model = self.view.set_stiffness(self._k_bend, f)
+        self.view.scale_damping(f)
 
     def set_hinge_parameters(self, stiffness=None, damping=None) -> None:
         """Set every hinge's bending stiffness (N m / rad) and/or viscous damping (N m s / rad),
@@ -225,7 +175,7 @@ class ActuatorPart:
         seed 001's model; see :mod:`mjeap.analysis.identify`). Hinge chain only. The timestep is not
         re-chosen: a stiffer, less damped chain than the model was built for can diverge
         (the step then raises :class:`DivergenceError`)."""
-        if self.representation != "hinge":
+        if not self.builder.per_hinge_parameters:
             raise ParameterError("representation", self.representation,
                                  "'hinge' (per-joint stiffness and damping are a hinge-chain notion)")
         n = self.layout.segments
@@ -235,13 +185,13 @@ class ActuatorPart:
             if not np.all(np.isfinite(k) & (k > 0)):
                 raise ParameterError("stiffness", stiffness, "positive finite values in N m/rad")
             self._k_bend = k / self.units.rotational_stiffness
-            self.model.jnt_stiffness[self.joint_ids] = self._k_bend * self._stiffness_scale
+            self.view.set_stiffness(self._k_bend, self._stiffness_scale)
         if damping is not None:
             b = np.broadcast_to(np.asarray(damping, float), (n,))
             if not np.all(np.isfinite(b) & (b >= 0)):
                 raise ParameterError("damping", damping, "finite values >= 0 in N m s/rad")
-            self._d0[self.bend_dof] = b / self.units.rotational_damping
-            self.model.dof_damping[self.bend_dof] = self._d0[self.bend_dof] * self._stiffness_scale
+            self.view.set_damping(b / self.units.rotational_damping)
+            self.view.scale_damping(self._stiffness_scale)
 
     # ------------------------------------------------------------------ tip loads
     def set_tip_force(self, force: Union[float, Sequence[float]]) -> None:

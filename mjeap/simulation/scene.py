@@ -23,7 +23,13 @@ Damping and timestep are derived from the compiled model, never tuned by hand:
    chain therefore gets joint damping (beta - h) k, so that the first mode's damping ratio
    is still zeta_1, and its timestep is at most beta / 2 (the joint keeps at least half).
    ``discrete`` also solves contacts in the metric M + hD + h^2 K of the implicit update:
-   systems with contact need it (:mod:`mjeap.simulation.system`).
+   systems with contact need it (:mod:`mjeap.simulation.system`). The rod (:mod:`mjeap.model.rod`) runs
+   under ``discrete`` only (MuJoCo 4.0 refuses rod elasticity under the implicit
+   integrators), which takes its elasticity implicitly as it does the hinge springs: no
+   stability limit, the flex's own Rayleigh damping gives it (beta - h) K and its
+   timestep is at most beta / 2. Its modes are those of its bending angles
+   (:meth:`mjeap.model.rod.RodBuilder.linearize`). Which of these apply to a beam is its
+   builder's to say (:class:`mjeap.model.mjcf.BeamBuilder`).
 4. The default timestep is min(T_1 / 50, T_el / 50, h_stab / 2): 50 steps per period of
    the first mode keeps its period error below 0.1 %; T_el bounds it near the buckling load,
    where T_1 grows without bound but the beam's elastic response to a drive does not; the
@@ -46,14 +52,14 @@ import numpy as np
 import scipy.linalg
 
 from .accuracy import check_accuracy
-from ..model.catalog import Actuator, get_actuator
-from .part import ActuatorPart, write_hinge_angles
-from ..model.discretize import BeamLayout, Payload, check_payload, clamp_rotation, discretize
 from ..errors import DivergenceError, ParameterError, check_positive, check_range
+from ..model.catalog import Actuator, get_actuator
+from ..model.discretize import BeamLayout, Payload, check_payload, clamp_rotation, discretize
+from ..model.fields import apply_dof_damping
 from ..model.mjcf import build_spec, get_builder
-from ..model.modes import linearize, modal_frequencies, stability_limit
-from ..model.fields import DOF_DAMPING_FIELD, apply_dof_damping
+from ..model.modes import modal_frequencies, stability_limit
 from ..units import DEFAULT_UNITS, UnitSystem
+from .part import ActuatorPart
 
 STEPS_PER_PERIOD = 50
 STABILITY_SAFETY = 0.5
@@ -110,10 +116,11 @@ class Scene:
     """A catalog actuator as a MuJoCo scene. Inputs and outputs in SI.
 
     Parameters: ``actuator`` (catalog id or :class:`Actuator`), ``representation``
-    ('hinge' | 'cable'), ``segments`` (>= 2), ``orientation`` ('horizontal' | 'up' |
-    'down'), ``payload`` (:class:`Payload` or 'MASS@POSITION'), ``units`` (internal
-    :class:`UnitSystem`), ``timestep`` (s, default from the model), ``integrator``
-    ('implicitfast' | 'discrete'), ``damping_ratio`` (first-mode, default from the
+    ('hinge' | 'cable' | 'rod', :mod:`mjeap.mjcf`), ``segments`` (>= 2), ``orientation``
+    ('horizontal' | 'up' | 'down'), ``payload`` (:class:`Payload` or 'MASS@POSITION'),
+    ``units`` (internal :class:`UnitSystem`), ``timestep`` (s, default from the model),
+    ``integrator`` ('implicitfast' | 'discrete'; default the representation's own:
+    'implicitfast', the rod 'discrete'), ``damping_ratio`` (first-mode, default from the
     catalog), ``gravity`` (bool), ``max_bend`` (rad: tip angle up to which the cable's
     timestep is checked for stability; the hinge chain needs none), ``accuracy`` (a
     target for this scene's rollouts, relative to the swing of the tip curvature: they
@@ -124,7 +131,7 @@ class Scene:
     def __init__(self, actuator: Union[str, Actuator], representation: str = "hinge",
                  segments: int = DEFAULT_SEGMENTS, orientation: str = "horizontal",
                  payload: Union[Payload, str, None] = None, units: Optional[UnitSystem] = None,
-                 timestep: Optional[float] = None, integrator: str = "implicitfast",
+                 timestep: Optional[float] = None, integrator: Optional[str] = None,
                  damping_ratio: Optional[float] = None, gravity: bool = True,
                  max_bend: float = DEFAULT_MAX_BEND, accuracy: Optional[float] = None):
         self.actuator = get_actuator(actuator)
@@ -135,10 +142,15 @@ class Scene:
         self._arguments = dict(actuator=self.actuator, representation=representation, orientation=orientation,
                                payload=payload, units=units, damping_ratio=damping_ratio, gravity=gravity,
                                max_bend=max_bend, accuracy=accuracy)
-        get_builder(representation)
+        self.builder = builder = get_builder(representation)
         clamp_rotation(orientation)
+        if integrator is None:
+            integrator = builder.default_integrator
         if integrator not in INTEGRATORS:
             raise ParameterError("integrator", integrator, f"one of {', '.join(INTEGRATORS)}")
+        why = builder.integrator_reason(integrator)
+        if why is not None:
+            raise ParameterError("integrator", integrator, " or ".join(map(repr, builder.integrators)), why)
         if isinstance(payload, str):
             payload = Payload.parse(payload)
         if payload is not None and not isinstance(payload, Payload):
@@ -185,7 +197,8 @@ class Scene:
                 f"{self.actuator.id}: smallest segment mass {self.layout.link_mass.min() / u.mass:.3g} and "
                 f"inertia {self.layout.link_inertia.min() / u.inertia:.3g} in these units; use e.g. the default "
                 f"(mm, mg, ms). MuJoCo said: {str(e).splitlines()[0]}") from None
-        self.linearization = lin = linearize(model)
+        b, hd, lay = self.builder, self.handles, self.layout
+        self.linearization = lin = b.linearize(model, hd, lay, u)
         lam, phi = scipy.linalg.eigh(lin.K, lin.M)       # gravity included, mass-normalised
         w2_el = modal_frequencies(lin, with_gravity=False)
         buckled = bool(lam[0] <= 0)
@@ -206,30 +219,29 @@ class Scene:
         k1 = float(phi[:, 0] @ (pattern * phi[:, 0]))
         beta = 2 * zeta * w1 / k1
         dof_damping = beta * pattern
-        kj = self.layout.hinge_stiffness / u.rotational_stiffness
-        for j, name in enumerate(self.handles.joints):
-            self.spec.joint(name).damping = [beta * kj[j], 0, 0]
-        if self.representation != "hinge":
-            self.spec.add_numeric(name=DOF_DAMPING_FIELD, data=list(dof_damping))
+        kj = lay.hinge_stiffness / u.rotational_stiffness
+        b.set_damping(self.spec, hd, beta, beta * kj, dof_damping if b.stores_dof_damping else None)
         T1, T_el = 2 * np.pi / w1, 2 * np.pi / w_el
         T_short = min(T1, T_el)
         h_stab = stability_limit(lin, dof_damping, self.integrator, h_max=T_short)
-        if self.representation != "hinge":
+        if b.check_bent_stability:
             # the cable's tangent stiffness stops being diagonal in the joint coordinates
             # once bent (the stiff in-plane direction couples into twist), so diagonal
             # damping no longer damps it: check the design bend too
-            bent = self._uniform_arc_qpos(model, self.max_bend)
-            h_stab = min(h_stab, stability_limit(linearize(model, qpos=bent), dof_damping,
+            bent = np.full(lay.segments, self.max_bend / lay.segments)
+            h_stab = min(h_stab, stability_limit(b.linearize(model, hd, lay, u, angles=bent), dof_damping,
                                                  self.integrator, h_max=T_short))
         # accuracy: 50 steps per period of the first mode, and of the first mode without
         # gravity's load (near the buckling load T1 grows without bound, the beam's elastic
         # response to a drive or a push does not). The drives are discretised exactly
         # (zero-order hold), so their time constants set no bound of their own.
         h_acc = T_short / STEPS_PER_PERIOD
-        # backward Euler on the hinge springs damps like Rayleigh damping with beta = h
-        numerical = self.integrator == "discrete" and self.representation == "hinge"
-        # the limits a timestep must keep (internal, why): stability, and under 'discrete' on
-        # the hinge chain (no stability limit there) accuracy and the joints' share of beta
+        # backward Euler on the hinge springs (the rod's elasticity) damps like Rayleigh
+        # damping with beta = h
+        numerical = b.implicit_stiffness(self.integrator)
+        # the limits a timestep must keep (internal, why): stability, and where the integrator
+        # takes the stiffness implicitly (no stability limit there) accuracy and the beam's
+        # share of beta
         self._timestep_limits = [(h_stab, (
             f"stability limit of {self.actuator.id} ({self.representation}, {self.layout.segments} "
             f"segments) under {self.integrator}: highest bending mode {wmax / u.time / 2 / np.pi:.4g} Hz "
@@ -266,8 +278,8 @@ class Scene:
             damping_ratio=zeta, rayleigh_beta=beta * u.time, integrator_beta=h_num * u.time, integrator=self.integrator,
             buckled=buckled, reason=reason)
         if numerical:
-            for name, b in zip(self.handles.joints, self.joint_damping(h * u.time, choice)):
-                self.spec.joint(name).damping = [b, 0, 0]
+            b.set_damping(self.spec, hd, self.rayleigh_share(h * u.time, choice), self.joint_damping(h * u.time, choice))
+        b.finish(self.spec, hd, h)
         return choice
 
     def check_timestep(self, timestep: float, name: str = "timestep") -> float:
@@ -286,10 +298,17 @@ class Scene:
         """Damping of each bending joint (internal units) that gives the first mode its
         damping ratio when stepped at ``timestep`` (s): beta k_j, of which 'discrete' adds
         h k_j itself on the hinge chain (backward Euler on the springs)."""
+        u = self.units
+        return self.rayleigh_share(timestep, choice) * self.layout.hinge_stiffness / u.rotational_stiffness
+
+    def rayleigh_share(self, timestep: float, choice: Optional[TimestepChoice] = None) -> float:
+        """The beam's own stiffness-proportional damping coefficient (internal time) when
+        stepped at ``timestep`` (s): beta, less the h that an integrator taking the stiffness
+        implicitly adds itself."""
         c, u = choice or self.choice, self.units
-        numerical = c.integrator == "discrete" and self.representation == "hinge"
+        numerical = self.builder.implicit_stiffness(c.integrator)
         beta = c.rayleigh_beta - (timestep if numerical else 0.0)
-        return max(beta, 0.0) / u.time * self.layout.hinge_stiffness / u.rotational_stiffness
+        return max(beta, 0.0) / u.time
 
     def variant(self, segments: int, timestep: float, integrator: str) -> "Scene":
         """This scene (actuator, orientation, payload, units, damping, gravity) as a model
@@ -302,14 +321,6 @@ class Scene:
         Scene.__init__(s, **{**self._arguments, "segments": segments, "timestep": timestep,
                              "integrator": integrator})
         return s
-
-    def _uniform_arc_qpos(self, model: mujoco.MjModel, tip_angle: float) -> np.ndarray:
-        q = model.qpos0.copy()
-        adr = np.array([model.jnt_qposadr[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, j)]
-                        for j in self.handles.joints])
-        write_hinge_angles(q, adr, np.full(len(adr), tip_angle / self.layout.segments),
-                            self.representation == "hinge")
-        return q
 
     @property
     def data(self) -> mujoco.MjData:
@@ -351,6 +362,7 @@ class Scene:
         """Reset to rest; ``curvature`` (1/m) starts the beam as a uniform arc of that
         curvature (seed 000 starts each experiment from a measured curvature)."""
         mujoco.mj_resetData(self.model, self.data)
+        self.part.forget_moments()           # mj_resetData clears qfrc_applied
         self.part.apply_loads()              # mj_resetData clears xfrc_applied; tip loads persist
         self.part.set_bending_stiffness_scale(1.0)
         if curvature:
@@ -360,8 +372,15 @@ class Scene:
 
     # ------------------------------------------------------------------ stepping
     def step(self, n: int = 1) -> None:
-        """Advance ``n`` steps; raises :class:`DivergenceError` if the state blows up."""
-        mujoco.mj_step(self.model, self.data, nstep=n)
+        """Advance ``n`` steps; raises :class:`DivergenceError` if the state blows up. Internal
+        moments set on a beam whose moments follow its geometry (the rod) are applied again
+        at each step's configuration."""
+        if self.part._moments is not None:
+            for _ in range(n):
+                self.part.reapply_moments()
+                mujoco.mj_step(self.model, self.data)
+        else:
+            mujoco.mj_step(self.model, self.data, nstep=n)
         self._step_count += n
         self.check_finite()
         self.update_kinematics()
@@ -396,9 +415,9 @@ class Scene:
         """Run to static equilibrium under the current loads with extra damping (first-mode
         damping ratio 0.3), returning the number of steps; the tip must move by less than
         ``tol`` x L over one first-mode period. Restores the scene's damping afterwards."""
-        m = self.model
-        saved = m.dof_damping.copy()
-        m.dof_damping[:] = saved * (SETTLING_DAMPING_RATIO / max(self.choice.damping_ratio, 1e-9))
+        view = self.part.view
+        saved = view.save_damping()
+        view.scale_saved_damping(saved, SETTLING_DAMPING_RATIO / max(self.choice.damping_ratio, 1e-9))
         period = max(1, int(round(1.0 / self.choice.first_frequency / self.timestep)))
         steps, last = 0, self.tip_position()
         try:
@@ -410,7 +429,7 @@ class Scene:
                     return steps
                 last = now
         finally:
-            m.dof_damping[:] = saved
+            view.restore_damping(saved)
         raise DivergenceError(f"{self.actuator.id}: did not settle within {max_periods} periods "
                               f"(tip still moving by {np.linalg.norm(now - last):.3g} m per period)")
 

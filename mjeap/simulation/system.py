@@ -240,6 +240,10 @@ def attach(spec: mujoco.MjSpec, actuator, *, prefix: str, site: Optional[str] = 
     gravity; springs or dampers switched off (and actuation, for a driven beam) are refused.
     With ``contact`` the beam's own parts (its payload, neighbouring links) never touch."""
     units = units or DEFAULT_UNITS
+    from ..model.mjcf import get_builder
+    why = get_builder(representation).attach_reason
+    if why is not None:
+        raise ParameterError("representation", representation, "'hinge' (or 'cable' on MuJoCo 3.x) for attach", why)
     integrator = integrator or ("discrete" if contact else "implicitfast")
     if not isinstance(prefix, str) or not _PREFIX.match(prefix):
         raise ParameterError("prefix", prefix, "a name of letters, digits, '_' or '-', starting with a letter")
@@ -397,7 +401,7 @@ class System:
             self.timestep_reason = "given by the user"
         self.spec = spec
         for a in self.actuators:
-            if a.twin.integrator == "discrete" and a.twin.representation == "hinge":
+            if a.twin.builder.implicit_stiffness(a.twin.integrator):
                 # discrete damps the beam by h K itself: the joints carry beta - h of the system's h
                 for name, b in zip(a.joints, a.twin.joint_damping(h)):
                     spec.joint(name).damping = [float(b), 0.0, 0.0]

@@ -1,4 +1,4 @@
-"""Beam mechanics of the simulated chain and cable against solutions by other methods (the
+"""Beam mechanics of the simulated chain, cable and rod against solutions by other methods (the
 elastica by scipy solve_bvp, the exact arc, the characteristic equation of the cantilever with
 tip mass, column buckling by shooting and by elliptic integrals) and the multilayer section
 against the thesis's printed results."""
@@ -46,9 +46,10 @@ def free_vibration_frequency(scene, periods: int = 12) -> float:
 
 
 def _representations():
-    """The beam representations this MuJoCo offers (the cable: 3.x only, mjeap.versions)."""
-    from ..versions import cable_available
-    return ("hinge", "cable") if cable_available() else ("hinge",)
+    """The beam representations this MuJoCo offers (the cable: 3.x only, the rod: 4.x only;
+    each builder says, mjeap.mjcf)."""
+    from ..mjcf import BUILDERS
+    return tuple(r for r, b in BUILDERS.items() if b.unavailable_reason() is None)
 
 
 @experiment("mechanics-elastica")
