@@ -64,7 +64,7 @@ def time_steps(model, data, min_seconds=0.5):
 
 def bench_models(min_seconds):
     from mjeap.assets import iter_assets
-    from mjeap.mjcf import BUILDERS
+    from mjeap.model.mjcf import BUILDERS
     rows = []
     for aid, rep in iter_assets():          # every representation that can build the beam
         if BUILDERS[rep].unavailable_reason() is None:  # and that this MuJoCo runs

@@ -17,7 +17,7 @@ if __name__ == "__main__":
     out = Path(sys.argv[1]) if len(sys.argv) > 1 else ASSET_DIR
     for name in write_assets(out):
         print(out / name)
-    from mjeap.mjcf import BUILDERS
+    from mjeap.model.mjcf import BUILDERS
     for rep, b in BUILDERS.items():
         if b.unavailable_reason() is not None:
             print(f"left as they are: the {rep} files ({b.unavailable_reason()})")

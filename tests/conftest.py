@@ -16,7 +16,7 @@ def pytest_collection_modifyitems(config, items):
     refused by mjeap, which tests/test_versions.py checks; the tests that need them are
     skipped with the reason: a test marked ``cable`` or ``dm_control``, or parametrised with
     the value 'cable'. Likewise the rod (mjeap.rod) on MuJoCo 3.x, with the reason mjeap gives."""
-    from mjeap.mjcf import BUILDERS
+    from mjeap.model.mjcf import BUILDERS
     from mjeap.versions import MUJOCO_VERSION, cable_available, dm_control_problem
     no_cable = pytest.mark.skip(reason=f"the cable representation needs MuJoCo 3.x (here {MUJOCO_VERSION})")
     rod_problem = BUILDERS["rod"].unavailable_reason()

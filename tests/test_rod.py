@@ -189,7 +189,7 @@ def test_native_and_threaded_engines_are_refused_naming_the_reason(rod):
 
 def test_accuracy_target_attach_and_hinge_parameters_are_refused(rod):
     import mujoco
-    from mjeap.system import attach
+    from mjeap.simulation.system import attach
     with pytest.raises(ParameterError, match=r"accuracy.*'rod' scene"):
         rollout(rod, "step:1V", 0.01, accuracy=1e-2)
     spec = mujoco.MjSpec.from_string('<mujoco><worldbody><site name="m"/></worldbody></mujoco>')
