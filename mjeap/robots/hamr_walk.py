@@ -200,17 +200,19 @@ class SoftStart:
 
 
 def trot_voltages(frequency: float, amplitude: float = AMPLITUDE, bias: float = BIAS,
-                  ramp_cycles: float = RAMP_CYCLES) -> dict:
+                  ramp_cycles: float = RAMP_CYCLES, lift_amplitude: Optional[float] = None) -> dict:
     """The trot, one waveform per actuator prefix: sine of ``amplitude`` about V_bias / 2 at
-    ``frequency``; the diagonal pairs in phase, the pairs 180 degrees apart, each lift 90
-    degrees ahead of its swing (mjeap's 'phase=' key, rad); amplitude ramped over
-    ``ramp_cycles`` cycles (:class:`SoftStart`)."""
+    ``frequency`` (the lifts: ``lift_amplitude``, default the same); the diagonal pairs in
+    phase, the pairs 180 degrees apart, each lift 90 degrees ahead of its swing (mjeap's
+    'phase=' key, rad); amplitude ramped over ``ramp_cycles`` cycles (:class:`SoftStart`)."""
     frequency = check_range("frequency", frequency, *FREQUENCY_RANGE, "Hz")
     amplitude = check_range("amplitude", amplitude, 0.0, 0.5 * bias, "V")
+    lift = amplitude if lift_amplitude is None else check_range("lift_amplitude", lift_amplitude, 0.0, 0.5 * bias,
+                                                                "V")
     out = {}
     for leg, (_, _, phase) in LEGS.items():
-        for dof, lead in (("swing", 0.0), ("lift", 0.5 * np.pi)):
-            text = f"sine:{amplitude:g}V@{frequency:g}Hz,offset={0.5 * bias:g}V,phase={phase + lead:.17g}"
+        for dof, lead, a in (("swing", 0.0, amplitude), ("lift", 0.5 * np.pi, lift)):
+            text = f"sine:{a:g}V@{frequency:g}Hz,offset={0.5 * bias:g}V,phase={phase + lead:.17g}"
             out[f"{leg}_{dof}"] = SoftStart(text, ramp_cycles / frequency)
     return out
 
@@ -250,7 +252,8 @@ def _durations(frequency: float, settle: Optional[float], measure: Optional[floa
 
 
 def walk(system: System, frequency: float, amplitude: float = AMPLITUDE, settle: Optional[float] = None,
-         measure: Optional[float] = None, samples_per_cycle: int = SAMPLES_PER_CYCLE) -> dict:
+         measure: Optional[float] = None, samples_per_cycle: int = SAMPLES_PER_CYCLE,
+         lift_amplitude: Optional[float] = None) -> dict:
     """Trot open loop at ``frequency`` (Hz) for ``settle`` + ``measure`` s (defaults: whole
     cycles, see SETTLE and MEASURE_*). Returns the samples (SI, world): time, body position
     and rotation, the feet's positions and velocities, which feet touch the ground, the
@@ -276,10 +279,11 @@ def walk(system: System, frequency: float, amplitude: float = AMPLITUDE, settle:
         rows["contact"].append([g in touching for g in fid])
         rows["penetration"].append(sy.penetration())
 
-    res = system.rollout(trot_voltages(frequency, amplitude, bias), settle + measure,
+    res = system.rollout(trot_voltages(frequency, amplitude, bias, lift_amplitude=lift_amplitude), settle + measure,
                          sample_interval=1.0 / (samples_per_cycle * frequency), on_sample=on_sample)
     run = {k: np.array(v) for k, v in rows.items()}
     run.update(time=res.time[:len(rows["body"])], result=res, frequency=float(frequency), amplitude=float(amplitude),
+               lift_amplitude=float(amplitude if lift_amplitude is None else lift_amplitude),
                t0=float(settle), ground=ground_rotation(system))
     return run
 
@@ -312,7 +316,7 @@ def walk_metrics(run: dict) -> dict:
     threshold = max(SLIDE_FRACTION * stance_speed, 1e-4)
     slides = (v_t > threshold) & c
     return {
-        "frequency_hz": f, "amplitude_v": run["amplitude"],
+        "frequency_hz": f, "amplitude_v": run["amplitude"], "lift_amplitude_v": run.get("lift_amplitude"),
         "speed_m_s": speed, "lateral_drift_m_s": lateral,
         "kinematic_speed_m_s": float(np.nanmean(v_est)) if any_c.any() else None,    # None: no foot ever down
         "stance_stroke_m": stroke, "duty_factor": duty,
