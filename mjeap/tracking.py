@@ -25,7 +25,7 @@ import numpy as np
 from .model.discretize import Payload
 from .errors import ParameterError
 from .engines.frame import check_initial_curvature, one_voltage
-from .engines.loop import advance
+from .engines import stepper
 
 __all__ = ["default_reference", "check_curvature_range", "check_mass_range", "draw_episode", "VoltageLimiter",
            "step_lockstep", "observe", "tracking_reward"]
@@ -119,9 +119,9 @@ class VoltageLimiter:
 
 def step_lockstep(scene, drive, voltage: float, nstep: int) -> None:
     """Advance ``nstep`` MuJoCo steps with ``voltage`` (V) held: the drive, then ``mj_step``,
-    once per step (the loop engine's :func:`mjeap.engines.loop.advance`). No divergence check and no kinematics
+    once per step (the environments' engine, :func:`mjeap.engines.stepper`). No divergence check and no kinematics
     update: the caller does both."""
-    advance(scene.model, scene.data, drive, voltage, scene.timestep, nstep)
+    stepper().advance(scene, drive, voltage, nstep)
     scene._step_count += nstep
 
 

@@ -130,3 +130,16 @@ def test_the_flat_layout_s_module_names_still_import_as_the_moved_modules():
     from mjeap.rollout import rollout
     assert Scene is mjeap.Scene and rollout is mjeap.rollout and callable(mjeap.rollout)
     assert importlib.import_module("mjeap.scene").__spec__.name == "mjeap.simulation.scene"
+
+
+def test_scenes_systems_and_environments_pick_their_engine_in_one_registry():
+    """A new engine is one module that registers itself: rollout's, System's and the
+    environments' engines all come from mjeap.engines' registry (the loop engine runs
+    systems and steps environments; the native and threaded engines say why they do not)."""
+    from mjeap import engines
+    from mjeap.robots import load
+    wing = load("robobee-wing", bias=100.0)
+    r = wing.rollout(["sine:50V@100Hz,offset=50V"], 0.002)
+    assert r.meta["engine"] == "loop" and "not native" in r.meta["engine_reason"]
+    assert engines.stepper().name == "loop"
+    assert "System" in engines.get_engine("threaded").system_reason(wing)

@@ -3,8 +3,9 @@
 An :class:`Engine` says whether it applies to a run (:meth:`Engine.why_not`: None, or the
 reason in words), which actuator part its samples read (:meth:`Engine.part`) and runs it
 (:meth:`Engine.run`) into sample stores of :mod:`mjeap.engines.frame`. :func:`choose` is
-the one place a run picks its engine: :func:`mjeap.rollout`, :func:`mjeap.rollout_batch`,
-:meth:`mjeap.System.rollout` and the environments go through it. Registered here:
+the one place a run picks its engine: :func:`mjeap.rollout` and :func:`mjeap.rollout_batch`
+go through it, :meth:`mjeap.System.rollout` through :func:`choose_system` and the
+environments through :func:`stepper`. Registered here:
 
 * ``native``: the drive compiled into the model (:mod:`mjeap.drives.native`), stepped by
   ``mujoco.rollout`` in C, batches over threads;
@@ -23,7 +24,8 @@ from typing import Dict, List, Tuple
 from ..errors import ParameterError
 from .base import Engine
 
-__all__ = ["Engine", "register_engine", "get_engine", "engine_names", "choose", "ENGINES"]
+__all__ = ["Engine", "register_engine", "get_engine", "engine_names", "choose", "choose_system", "stepper",
+           "ENGINES"]
 
 
 _REGISTRY: Dict[str, Engine] = {}
@@ -72,6 +74,29 @@ def choose(name: str, scene, drive, controller=None, batched: bool = False) -> T
         raise ParameterError("engine", "auto", "an engine that runs this batch: " + "; ".join(tried),
                              "rollout_batch needs the native or threaded engine; run the loop engine per rollout")
     raise ParameterError("engine", name, "an engine that applies: " + "; ".join(tried))   # pragma: no cover
+
+
+def choose_system(name: str, system, controller=None, on_sample=None) -> Tuple[Engine, str]:
+    """The engine for a run of a :class:`mjeap.System` and why (as :func:`choose`)."""
+    if name != "auto":
+        engine = get_engine(name)
+        why = engine.system_reason(system, controller, on_sample)
+        if why is not None:
+            raise ParameterError("engine", name, f"an engine that runs this system ('auto'): {why}")
+        return engine, "asked for"
+    tried = []
+    for engine in _REGISTRY.values():
+        why = engine.system_reason(system, controller, on_sample)
+        if why is None:
+            return engine, "; ".join(["auto"] + tried)
+        tried.append(f"not {engine.name}: {why}")
+    raise ParameterError("engine", name, "an engine that runs this system: " + "; ".join(tried))  # pragma: no cover
+
+
+def stepper(name: str = "loop") -> Engine:
+    """The engine an environment steps with (:meth:`Engine.advance`): the loop engine, the
+    one that steps a drive with its beam one step at a time."""
+    return get_engine(name)
 
 
 from . import native as _native, threaded as _threaded, loop as _loop  # noqa: E402  registration order = auto's

@@ -7,7 +7,9 @@ __all__ = ["Engine"]
 
 
 class Engine:
-    """One way of stepping a run of a scene (internal units, the scene's timestep)."""
+    """One way of stepping a run (internal units, the model's timestep): of a scene
+    (:meth:`run`), of a system of actuators (:meth:`run_system`) or of an environment, step
+    by step (:meth:`advance`). An engine that offers only some says why not for the others."""
 
     #: registry name
     name: str = ""
@@ -31,3 +33,19 @@ class Engine:
         store), filling the stores; raises DivergenceError at the first diverged state and
         leaves the scene in the final state of the last run."""
         raise NotImplementedError
+
+    def system_reason(self, system, controller=None, on_sample=None) -> Optional[str]:
+        """None where this engine runs ``system`` (a :class:`mjeap.System`: the drives
+        compiled in, one ctrl per actuator); else why not."""
+        return f"the {self.name} engine runs one actuator's scene, not a System"
+
+    def run_system(self, system, n_steps: int, sample_steps, before, sample, check) -> None:
+        """Step ``system`` ``n_steps`` times: ``before(k)`` sets the ctrl held over step k,
+        ``check(k + 1, k)`` raises on a diverged state, ``sample(i, k)`` samples after step k
+        = ``sample_steps[i]`` (:func:`mjeap.engines.frame.lockstep`'s contract)."""
+        raise NotImplementedError(self.system_reason(system))
+
+    def advance(self, scene, drive, voltage: float, nstep: int = 1) -> None:
+        """``nstep`` steps of ``scene`` with ``drive`` at a held ``voltage`` (V): an
+        environment's step. No divergence check, no kinematics update."""
+        raise NotImplementedError(f"the {self.name} engine does not step environments")

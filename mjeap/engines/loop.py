@@ -50,9 +50,19 @@ def divergence_error(scene, drv, voltage: float, step: int, who: str = "") -> Di
 
 
 class LoopEngine(Engine):
-    """Every drive, open or closed loop, one run at a time."""
+    """Every drive, open or closed loop, one run at a time; systems (their drives compiled
+    in, the ctrl set per step) and environments, step by step."""
 
     name, batched = "loop", False
+
+    def system_reason(self, system, controller=None, on_sample=None):
+        return None
+
+    def run_system(self, system, n_steps, sample_steps, before, sample, check) -> None:
+        lockstep(system.model, system.data, n_steps, sample_steps, before, sample, check)
+
+    def advance(self, scene, drive, voltage, nstep=1) -> None:
+        advance(scene.model, scene.data, drive, voltage, scene.timestep, nstep)
 
     def run(self, scene, drives, v_steps, initial_curvatures, sample_steps, samples, *, nthread=0, progress=None,
             check_every=100, controller=None, meta=None) -> None:

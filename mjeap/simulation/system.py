@@ -602,7 +602,7 @@ class System:
     @guarded("rrd")
     def rollout(self, voltages, duration: float, initial_curvatures: Union[float, Sequence[float]] = 0.0,
                 sample_interval: Optional[float] = None, rrd: Union[str, Path, None] = None,
-                on_sample=None, controller=None) -> SystemResult:
+                on_sample=None, controller=None, engine: str = "auto") -> SystemResult:
         """Run for ``duration`` s with one voltage per actuator (waveform text,
         :class:`~mjeap.Waveform`, callable v(t) or None for its rest voltage; a list or a dict
         by prefix). Returns a :class:`SystemResult`; with ``rrd`` a Rerun recording (written
@@ -612,10 +612,13 @@ class System:
         (``voltages`` then None) is called before every step and returns the voltages (V) to
         hold over it, one per actuator or a dict by prefix (None: unchanged); each is checked
         against its drive's safe range. It may read the system's state; a controller that
-        senses an actuator's current steps a :meth:`drive_observer` with them."""
-        from ..engines.frame import (Samples, check_work, lockstep, sample_steps as steps_of, to_waveform, voltage_steps)
+        senses an actuator's current steps a :meth:`drive_observer` with them. ``engine``: one
+        that runs systems (:func:`mjeap.engines.choose_system`; 'auto': the loop engine)."""
+        from ..engines import choose_system
+        from ..engines.frame import Samples, check_work, sample_steps as steps_of, to_waveform, voltage_steps
         from ..io.outputs import write_outputs
         duration = check_positive("duration", duration, "s")
+        eng, engine_reason = choose_system(engine, self, controller, on_sample)
         if controller is not None:
             if voltages is not None and any(v is not None for v in self._per_actuator("voltages", voltages)):
                 raise ParameterError("voltages", voltages, "None when a controller sets the voltages")
@@ -655,6 +658,7 @@ class System:
                                                                  None if w is None else getattr(w, "text", str(w)))}
                               for a, w in zip(self.actuators, waves)},
                 "duration_s": duration, "steps": n_steps, "timestep_s": dt, "timestep_reason": self.timestep_reason,
+                "engine": eng.name, "engine_reason": engine_reason,
                 "units": self.units.describe()}
         ws = np.empty(m.nv)
 
@@ -686,7 +690,7 @@ class System:
         try:
             if controller is not None:          # the voltage over step 0 is the first sample's
                 self._control(controller(0.0, self), v_steps, 0, ctrl_name)
-            lockstep(m, d, n_steps, sample_steps, before, sample, check)
+            eng.run_system(self, n_steps, sample_steps, before, sample, check)
             self._step_count = n_steps
         except BaseException as e:
             error = e
