@@ -50,47 +50,48 @@ def get_engine(name: str) -> Engine:
     return _REGISTRY[name]
 
 
+def _pick(name: str, why_not, asked: str, none_applies: str, skip=lambda engine: False,
+          hint: str = "") -> Tuple[Engine, str]:
+    """The engine ``name``, refused with ``asked`` and its ``why_not(engine)`` where that is
+    not None; or with ``auto`` the first registered one (not ``skip``-ped) that applies, the
+    reasons of those before it said; refused with ``none_applies`` (and ``hint``) where none
+    does."""
+    if name != "auto":
+        engine = get_engine(name)
+        why = why_not(engine)
+        if why is not None:
+            raise ParameterError("engine", name, f"{asked}: {why}")
+        return engine, "asked for"
+    tried = []
+    for engine in _REGISTRY.values():
+        if skip(engine):
+            continue
+        why = why_not(engine)
+        if why is None:
+            return engine, "; ".join(["auto"] + tried)
+        tried.append(f"not {engine.name}: {why}")
+    raise ParameterError("engine", name, f"{none_applies}: " + "; ".join(tried), hint)
+
+
 def choose(name: str, scene, drive, controller=None, batched: bool = False) -> Tuple[Engine, str]:
     """The engine for a run and why: ``name`` if it applies (refused with its reason if
     not), or with ``auto`` the first registered one that applies (``batched``: among those
     that run batches, refused naming each one's reason where none does)."""
-    if name != "auto":
-        engine = get_engine(name)
-        why = "it runs one rollout at a time (rollout_batch needs a batched engine)" \
-            if batched and not engine.batched else engine.why_not(scene, drive, controller)
-        if why is not None:
-            ok = "'auto'" if batched else "'loop' or 'auto'"
-            raise ParameterError("engine", name, f"{ok} for this run: {why}")
-        return engine, "asked for"
-    tried = []
-    for engine in _REGISTRY.values():
+    def why_not(engine):
         if batched and not engine.batched:
-            continue
-        why = engine.why_not(scene, drive, controller)
-        if why is None:
-            return engine, "; ".join(["auto"] + tried)
-        tried.append(f"not {engine.name}: {why}")
-    if batched:
-        raise ParameterError("engine", "auto", "an engine that runs this batch: " + "; ".join(tried),
-                             "rollout_batch needs the native or threaded engine; run the loop engine per rollout")
-    raise ParameterError("engine", name, "an engine that applies: " + "; ".join(tried))   # pragma: no cover
+            return "it runs one rollout at a time (rollout_batch needs a batched engine)"
+        return engine.why_not(scene, drive, controller)
+    return _pick(name, why_not, "'auto' for this run" if batched else "'loop' or 'auto' for this run",
+                 "an engine that runs this batch" if batched else "an engine that applies",
+                 skip=lambda engine: batched and not engine.batched,
+                 hint="rollout_batch needs the native or threaded engine; run the loop engine per rollout"
+                 if batched else "")
 
 
 def choose_system(name: str, system, controller=None, on_sample=None) -> Tuple[Engine, str]:
     """The engine for a run of a :class:`mjeap.System` and why (as :func:`choose`)."""
-    if name != "auto":
-        engine = get_engine(name)
-        why = engine.system_reason(system, controller, on_sample)
-        if why is not None:
-            raise ParameterError("engine", name, f"an engine that runs this system ('auto'): {why}")
-        return engine, "asked for"
-    tried = []
-    for engine in _REGISTRY.values():
-        why = engine.system_reason(system, controller, on_sample)
-        if why is None:
-            return engine, "; ".join(["auto"] + tried)
-        tried.append(f"not {engine.name}: {why}")
-    raise ParameterError("engine", name, "an engine that runs this system: " + "; ".join(tried))  # pragma: no cover
+    return _pick(name, lambda engine: engine.system_reason(system, controller, on_sample),
+                 "an engine that runs this system ('auto')", "an engine that runs this system")
 
 
 def stepper(name: str = "loop") -> Engine:

@@ -3,7 +3,10 @@ from __future__ import annotations
 
 from typing import Optional, Sequence
 
-__all__ = ["Engine"]
+__all__ = ["Engine", "CONTROLLER_REASON"]
+
+#: why an engine that precomputes the run (native, threaded) cannot take a controller
+CONTROLLER_REASON = "a controller closes the loop (its voltage depends on the state)"
 
 
 class Engine:

@@ -9,14 +9,14 @@ import mujoco
 import numpy as np
 
 from ..drives.base import NativeForm
-from .base import Engine
+from .base import CONTROLLER_REASON, Engine
 from .threaded import LOADS, NATIVE_CONTROL, STATE, raise_bad, roll
 
 
 def why_not(scene, drive, controller=None) -> Optional[str]:
     """None where the native engine applies to this run of ``scene``; else why not."""
     if controller is not None:
-        return "a controller closes the loop (its voltage depends on the state)"
+        return CONTROLLER_REASON
     if scene.builder.native_reason is not None:
         return scene.builder.native_reason
     reason = drive.native_reason()

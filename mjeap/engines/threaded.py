@@ -26,7 +26,7 @@ import numpy as np
 from mujoco import rollout as mj_rollout
 
 from ..errors import DivergenceError
-from .base import Engine
+from .base import CONTROLLER_REASON, Engine
 
 STATE = mujoco.mjtState.mjSTATE_FULLPHYSICS
 CONTROL = mujoco.mjtState.mjSTATE_QFRC_APPLIED
@@ -46,7 +46,7 @@ def _error(scene, drive, voltage, b, B, note="") -> DivergenceError:
 def why_not(scene, drive, controller=None) -> Optional[str]:
     """None where the threaded engine applies to this run; else the reason, in words."""
     if controller is not None:
-        return "a controller closes the loop (its voltage depends on the state)"
+        return CONTROLLER_REASON
     if scene.builder.threaded_reason is not None:
         return scene.builder.threaded_reason
     reason = drive.closed_loop_reason()

@@ -202,7 +202,8 @@ def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable
     waves = [to_waveform(v, duration) for v in voltages]
     v_steps = [voltage_steps(w, duration, dt, d) for w, d in zip(waves, drives)]
     steps = sample_steps(len(v_steps[0]), dt, sample_interval)
-    samples = [Samples(eng.part(scene, drives[0]), len(steps)) for _ in voltages]
+    part = eng.part(scene, drives[0])
+    samples = [Samples(part, len(steps)) for _ in voltages]
     wall0 = _time.perf_counter()
     eng.run(scene, drives, v_steps, list(kappa0), steps, samples, nthread=nthread)
     wall = _time.perf_counter() - wall0
