@@ -130,13 +130,31 @@ SLIDE_FRACTION = 0.1            # a contact foot slides above this fraction of i
 
 
 def build(mu: float = MU, segments: int = SEGMENTS, bias: float = BIAS, incline_deg: float = 0.0,
-          d: Optional[dict] = None) -> System:
+          d: Optional[dict] = None, armature_fraction: float = 0.0, foot_drop: float = FOOT_DROP,
+          body_width: float = BODY_WIDTH, timeconst_steps: float = 2.0) -> System:
     """The robot as a System (host in mm, mg, ms) standing on a ground plane tilted by
-    ``incline_deg`` about y (uphill along +x); ``d``: hamr_leg.design() (computed if None)."""
+    ``incline_deg`` about y (uphill along +x); ``d``: hamr_leg.design() (computed if None).
+
+    For the roll-over study (mjeap.robots.hamr_walk_study), each a model parameter whose
+    true value is not published: ``armature_fraction`` of each leg joint's design inertia
+    is carried as joint armature (a rotor on the joint: it enters that joint's own inertia
+    only, so the transmission resonances stay, but it exchanges no momentum with the body)
+    instead of by the leg's moving masses, whose masses scale by 1 - armature_fraction (the
+    body's own mass takes up the rest: the robot still weighs TOTAL_MASS); ``foot_drop`` (m):
+    the foot below the leg rod's end (its lateral motion per radian of lift); ``body_width``
+    (m): the chassis width, the hips at its sides; ``timeconst_steps``: the contact's time
+    constant in timesteps (ContactParameters)."""
     mu = check_range("mu", mu, 0.0, 10.0)
     segments = check_integer("segments", segments, 1, 40)
     incline = np.radians(check_range("incline_deg", incline_deg, -45.0, 45.0, "deg"))
+    armature_fraction = check_range("armature_fraction", armature_fraction, 0.0, 1.0, hi_open=True)
+    foot_drop = check_range("foot_drop", foot_drop, 0.0, 0.05, "m")
+    body_width = check_range("body_width", body_width, 6e-3, 0.1, "m")
+    timeconst_steps = check_range("timeconst_steps", timeconst_steps, 2.0, 100.0)
     d = design() if d is None else d
+    if armature_fraction:
+        d = {n: {**v, "joint_inertia_kg_m2": v["joint_inertia_kg_m2"] * (1.0 - armature_fraction)}
+             for n, v in d.items()}
     spec = mujoco.MjSpec.from_string('<mujoco><option gravity="0 0 -9.80665e-3"/><worldbody/></mujoco>')
     wb = spec.worldbody
     # the ground: a plane turned about y by -incline (its +x rises), the robot on it
@@ -144,8 +162,8 @@ def build(mu: float = MU, segments: int = SEGMENTS, bias: float = BIAS, incline_
     wb.add_geom(name="ground", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[200.0, 200.0, 1.0], quat=q_ground,
                 rgba=[0.85, 0.85, 0.8, 1], contype=0, conaffinity=1, condim=3)
     mm = 1e3
-    L, W, H = BODY_LENGTH * mm, BODY_WIDTH * mm, BODY_HEIGHT * mm
-    hip_height = (FOOT_DROP + FOOT_RADIUS) * mm + 0.02          # feet 20 um above the ground at the start
+    L, W, H = BODY_LENGTH * mm, body_width * mm, BODY_HEIGHT * mm
+    hip_height = (foot_drop + FOOT_RADIUS) * mm + 0.02          # feet 20 um above the ground at the start
     R_ground = np.zeros(9)
     mujoco.mju_quat2Mat(R_ground, np.array(q_ground))
     body = wb.add_body(name="body", pos=(R_ground.reshape(3, 3) @ [0, 0, hip_height]).tolist(), quat=q_ground)
@@ -163,7 +181,12 @@ def build(mu: float = MU, segments: int = SEGMENTS, bias: float = BIAS, incline_
     for leg, (fore, side, _) in LEGS.items():
         add_leg(spec, body, {dof: acts[f"{leg}_{dof}"] for dof in ("swing", "lift")}, d, prefix=f"{leg}/",
                 pos=[fore * HIP_X * mm, side * W / 2, 0.0], side=side, mass_radius=LEG_LENGTH * mm,
-                foot_drop=FOOT_DROP * mm, foot_radius=FOOT_RADIUS * mm, foot_contact=True)
+                foot_drop=foot_drop * mm, foot_radius=FOOT_RADIUS * mm, foot_contact=True)
+        if armature_fraction:
+            u0 = acts[f"{leg}_swing"].twin.units
+            for dof in ("swing", "lift"):
+                full = d[dof]["joint_inertia_kg_m2"] / (1.0 - armature_fraction)
+                spec.joint(f"{leg}/{dof}").armature = armature_fraction * full / (u0.mass * u0.length**2)
     # the body's own mass: what the actuators and legs leave of TOTAL_MASS
     m = spec.copy().compile()
     bid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "body")
@@ -175,7 +198,8 @@ def build(mu: float = MU, segments: int = SEGMENTS, bias: float = BIAS, incline_
     acts_list = list(acts.values())
     u = acts_list[0].twin.units
     h = min(a.twin.timestep for a in acts_list)
-    contact = ContactParameters(friction=(mu, 5e-6, 1e-7), impratio=IMPRATIO, width_fraction=CONTACT_WIDTH_FRACTION)
+    contact = ContactParameters(friction=(mu, 5e-6, 1e-7), impratio=IMPRATIO, width_fraction=CONTACT_WIDTH_FRACTION,
+                                timeconst_steps=timeconst_steps)
     # System applies contact parameters only for actuators with contact: here the feet's
     contact.apply(spec, h / u.time, FOOT_RADIUS / u.length, u.length)
     return System(spec, acts_list, contact=contact)
