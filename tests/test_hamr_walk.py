@@ -88,3 +88,25 @@ def test_the_command_line_refuses_a_frequency_out_of_range(capsys):
     with pytest.raises(SystemExit) as e:
         hw.main(["--frequencies", "150", "--quick"])
     assert e.value.code == 2 and "--frequencies" in capsys.readouterr().err
+
+
+def test_each_leg_joint_carries_the_design_inertia_and_its_stage_turns_on_its_axis(system):
+    """Reference: hamr_leg.design() (the joint inertias that put the loaded actuators at
+    100 / 80 Hz). The robot's joint-space inertia of each leg joint at the start equals the
+    design's (the single leg's, rel 1e-6), and each swing stage's centre of mass lies on its
+    swing axis: an unset ipos put it at twice the hip offset (16 mm off the axis), doubling
+    the swing inertia (resonance 100 / sqrt 2 = 71 Hz) and swinging an eccentric mass."""
+    import mujoco
+    m = system.model
+    d = mujoco.MjData(m)                         # the initial pose (the fixture's data may have walked)
+    mujoco.mj_forward(m, d)
+    M = np.zeros((m.nv, m.nv))
+    mujoco.mj_fullM(m, d, M)
+    des = hw.design()
+    to_si = system.units.mass * system.units.length**2
+    for leg in hw.LEGS:
+        for dof in ("swing", "lift"):
+            k = m.jnt_dofadr[mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, f"{leg}/{dof}")]
+            assert M[k, k] * to_si == pytest.approx(des[dof]["joint_inertia_kg_m2"], rel=1e-6), (leg, dof)
+        b = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, f"{leg}/swing_stage")
+        assert np.allclose(d.xipos[b], d.xpos[b], atol=1e-9)

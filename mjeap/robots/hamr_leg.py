@@ -131,7 +131,10 @@ def add_leg(spec: mujoco.MjSpec, parent, acts: dict, d: dict, *, prefix: str = "
     stage.add_geom(name=f"{prefix}stage", type=mujoco.mjtGeom.mjGEOM_CYLINDER, size=[1.0, 0.2, 0], mass=0,
                    rgba=[0.6, 0.6, 0.65, 1], contype=0, conaffinity=0)
     stage.mass, stage.inertia = 2 * (I_s - I_leg) / r**2, [(I_s - I_leg) / 2, (I_s - I_leg) / 2, I_s - I_leg]
-    stage.explicitinertial = True
+    # its centre of mass on the swing axis, stated: left unset, MuJoCo's compiler puts an
+    # explicit inertial at the body's pos again (the hip's offset twice: at HAMR-VI's hips
+    # that doubled the swing joint's inertia and swung 8 mg on a 16 mm eccentric)
+    stage.ipos, stage.explicitinertial = [0, 0, 0], True
     leg = stage.add_body(name=f"{prefix}leg")
     leg.add_joint(name=f"{prefix}lift", type=mujoco.mjtJoint.mjJNT_HINGE, axis=AXES["lift"],
                   damping=d["lift"]["joint_damping_N_m_s"] / (to_I / u.time))
@@ -146,7 +149,7 @@ def add_leg(spec: mujoco.MjSpec, parent, acts: dict, d: dict, *, prefix: str = "
     lever.add_geom(name=f"{prefix}lever", type=mujoco.mjtGeom.mjGEOM_CAPSULE, fromto=[0, 0, 1.5, 0, 0, -1.5],
                    size=[0.2, 0, 0], mass=0, rgba=[0.6, 0.6, 0.65, 1], contype=0, conaffinity=0)
     lever.mass, lever.inertia = 3 * (I_l - I_leg) / r**2, [I_l - I_leg, I_l - I_leg, 1e-6 * (I_l - I_leg)]
-    lever.explicitinertial = True
+    lever.ipos, lever.explicitinertial = [0, 0, 0], True
     foot = [0, y, -foot_drop]
     if foot_drop:
         leg.add_geom(name=f"{prefix}shank", type=mujoco.mjtGeom.mjGEOM_CAPSULE, fromto=[0, y, 0, *foot],
