@@ -78,6 +78,20 @@ Findings (4 segments, mu 0.51; wall time 3.5-7 s per simulated second on 2 share
   (-0.30 m/s), where the lift (80 Hz) lags its drive by 90 deg and the swing (100 Hz) by
   12 deg, so the feet touch down while swinging forward; the paper's phase loop exists
   for this.
+- Measured before the fix of hamr_leg.add_leg's swing-stage centre of mass (commit
+  41b82c0: the robot's swing joints had carried twice the design inertia); the roll-over at
+  65 Hz is re-measured after it in mjeap.robots.hamr_walk_study: at full drive the 65 Hz
+  trot still rolls over, whatever single model parameter is changed; the lift amplitude
+  decides it (full swing with a 20 V lift: upright, 0.256 m/s; 30 V: 0.186 m/s; 40 V and
+  up: thrown off its feet), the lift transmission amplifying 2.9x at 65 Hz. Speed-frequency
+  (full swing, lift 20 V): 5, 10, 20, 40, 65 Hz: 0.067, 0.146, 0.282, 0.251, 0.256 m/s
+  (no-slip estimate 0.063, 0.135, 0.311, 0.392, 0.963), 80 and 100 Hz roll over.
+- The contact-force plot's spikes (18 N on FL's leg at t = 0.735 s in the 10 Hz run, 1300x
+  the weight): a foot striking the ground at 0.59 m/s (the body rocking onto it), stopped
+  within the contact's time constant (2 timesteps, 21 us): F ~ m_eff v / tau. The units are
+  right (mj_contactForce in mg mm / ms^2 = 1 mN); the peak is set by the numerical time
+  constant, not a physical stiffness, and the plot samples the instantaneous force every
+  2 ms, so it shows such a 20 us impact only when a sample falls in it.
 - Incline (the ground tilted, gravity along -z): full amplitude at 10 Hz climbs 4 deg, not
   8; 30 V at 20 Hz climbs 8, not 12 (the paper: nearly 22 deg).
 """
