@@ -253,10 +253,11 @@ def _durations(frequency: float, settle: Optional[float], measure: Optional[floa
 
 def walk(system: System, frequency: float, amplitude: float = AMPLITUDE, settle: Optional[float] = None,
          measure: Optional[float] = None, samples_per_cycle: int = SAMPLES_PER_CYCLE,
-         lift_amplitude: Optional[float] = None) -> dict:
+         lift_amplitude: Optional[float] = None, controller=None) -> dict:
     """Trot open loop at ``frequency`` (Hz) for ``settle`` + ``measure`` s (defaults: whole
-    cycles, see SETTLE and MEASURE_*). Returns the samples (SI, world): time, body position
-    and rotation, the feet's positions and velocities, which feet touch the ground, the
+    cycles, see SETTLE and MEASURE_*), or under ``controller`` (a system controller, e.g.
+    :class:`TrotPhaseControllers`, see :func:`walk_closed_loop`). Returns the samples (SI,
+    world): time, body position and rotation, the feet's positions and velocities, which feet touch the ground, the
     deepest penetration; the rollout's result; the measuring window's start ``t0``."""
     bias = system.actuators[0].drive.params["bias"]
     settle, measure = _durations(frequency, settle, measure)
@@ -279,8 +280,9 @@ def walk(system: System, frequency: float, amplitude: float = AMPLITUDE, settle:
         rows["contact"].append([g in touching for g in fid])
         rows["penetration"].append(sy.penetration())
 
-    res = system.rollout(trot_voltages(frequency, amplitude, bias, lift_amplitude=lift_amplitude), settle + measure,
-                         sample_interval=1.0 / (samples_per_cycle * frequency), on_sample=on_sample)
+    volts = None if controller is not None else trot_voltages(frequency, amplitude, bias, lift_amplitude=lift_amplitude)
+    res = system.rollout(volts, settle + measure, sample_interval=1.0 / (samples_per_cycle * frequency),
+                         on_sample=on_sample, controller=controller)
     run = {k: np.array(v) for k, v in rows.items()}
     run.update(time=res.time[:len(rows["body"])], result=res, frequency=float(frequency), amplitude=float(amplitude),
                lift_amplitude=float(amplitude if lift_amplitude is None else lift_amplitude),
@@ -333,6 +335,153 @@ def walk_metrics(run: dict) -> dict:
         "wall_s_per_simulated_s": float(run["result"].meta["wall_time_s"] / t[-1]),
     }
 
+
+
+# ---- closed loop: the single leg's two phase loops on all eight actuators (issue 25) ----
+LOOP_FREQUENCY, LOOP_AMPLITUDE = 80.0, 20.0     # Hz, V: open loop the robot walks backward here (the lift lags)
+OPEN_LOOP_CYCLES = RAMP_CYCLES + 4              # cycles before the loops close (the soft start, then 4)
+LOOP_CYCLES = 40                                # cycles of a closed-loop walk, the open-loop ones included
+LOOP_MEASURE_CYCLES = 16                        # the walk metrics of a closed-loop walk: its last cycles
+PHASE_TOL_DEG = 5.0                             # deg, seed 003's "within 5 degrees"
+#: Hz, the free actuator's calibration sweep (as the single leg's free_estimator)
+ESTIMATOR_FREQUENCIES = (100.0, 1000.0, 1500.0, 1750.0, 2000.0)
+FOOT_AXIS = {"swing": 0, "lift": 2}             # the foot's body-frame coordinate: fore-aft x, normal z
+
+
+def desired_phases() -> dict:
+    """Per actuator prefix the desired phase (rad, against sin(omega t)) of its foot's
+    coordinate relative to the body (fore-aft for a swing, normal for a lift): the trot's,
+    as :func:`trot_voltages` drives it (each transmission moves its foot +x or +z for a
+    positive drive on either side)."""
+    return {f"{leg}_{dof}": phase + lead for leg, (_, _, phase) in LEGS.items()
+            for dof, lead in (("swing", 0.0), ("lift", 0.5 * np.pi))}
+
+
+def walker_estimator(system: System):
+    """Eqs. 7-9 calibrated once on the free pzt-hamr-small (no leg, no robot) at the
+    walker's bias and segments, as the single leg's free_estimator (its sweep frequencies,
+    ESTIMATOR_FREQUENCIES); not changed for the legs or the ground."""
+    from ..controllers.hamr_leg import free_actuator
+    from ..controllers.self_sensing import calibrate_on_free_actuator
+    a = system.actuators[0]
+    return calibrate_on_free_actuator(free_actuator(), a.drive.params["bias"], ESTIMATOR_FREQUENCIES, gravity=False,
+                                      segments=system.parts[0].layout.segments)
+
+
+def walk_loop_gains(frequency: float) -> dict:
+    """Per degree of freedom the phase loop's (kp, ki, kd) per cycle at the trot
+    ``frequency`` (Hz): controllers.hamr_leg.phase_loop_gains on the transmission's
+    second-order model (resonance 100 Hz swing, 80 Hz lift, damping ratio hamr_leg.ZETA)."""
+    from ..controllers.hamr_leg import phase_loop_gains
+    frequency = check_range("frequency", frequency, *FREQUENCY_RANGE, "Hz")
+    return {dof: phase_loop_gains(hamr_leg.ZETA, tr.resonance, frequency) for dof, tr in hamr_leg.DOFS.items()}
+
+
+class TrotPhaseControllers:
+    """The eight phase loops as one system controller: per actuator a
+    controllers.hamr_leg.LegPhaseController (the single leg's) driving V_bias/2 + a sin(omega t
+    + phi), phi starting at the trot's phase (:func:`desired_phases`), the amplitude ramped
+    over RAMP_CYCLES as the open-loop trot's; after ``open_loop_cycles`` phi moves once per
+    cycle by the PI on the sensed foot phase error. Each loop reads only its own actuator's
+    drive current (a drive observer stepped with the voltage it holds) through its own copy
+    of ``estimator`` (:func:`walker_estimator` if None); nothing else of the simulator."""
+
+    name = "eight foot phase PIs on the self-sensed currents"
+
+    def __init__(self, system: System, frequency: float, amplitude: float = LOOP_AMPLITUDE,
+                 open_loop_cycles: int = OPEN_LOOP_CYCLES, estimator=None, gains: Optional[dict] = None):
+        import copy
+        from ..controllers.hamr_leg import LegPhaseController
+        bias = system.actuators[0].drive.params["bias"]
+        frequency = check_range("frequency", frequency, *FREQUENCY_RANGE, "Hz")
+        amplitude = check_range("amplitude", amplitude, 0.0, 0.5 * bias, "V", lo_open=True)
+        open_loop_cycles = check_integer("open_loop_cycles", open_loop_cycles, RAMP_CYCLES, 10_000)
+        est = walker_estimator(system) if estimator is None else estimator
+        gains = walk_loop_gains(frequency) if gains is None else gains
+        self.frequency, self.open_loop_cycles, self.dt = frequency, open_loop_cycles, system.timestep
+        self.ctrls, self.obs = {}, {}
+        for prefix, phase in desired_phases().items():
+            c = LegPhaseController(copy.deepcopy(est), frequency, amplitude, phase, gains[prefix.split("_")[1]],
+                                   open_loop_cycles, initial_phase=phase, ramp=RAMP_CYCLES / frequency)
+            self.obs[prefix] = system.drive_observer(prefix)
+            c.reset(system, self.obs[prefix])
+            self.ctrls[prefix] = c
+
+    def __call__(self, t: float, system: System) -> dict:
+        out = {}
+        for prefix, c in self.ctrls.items():
+            out[prefix] = c(t, None)            # reads the current after the last step, nothing of the system
+            self.obs[prefix].step(out[prefix], self.dt)
+        return out
+
+
+def foot_phase_errors(run: dict, cycles: int) -> dict:
+    """Per actuator prefix the true phase error (deg) of its foot per drive cycle, for the
+    first ``cycles`` cycles of a :func:`walk`: the foot's simulated 3D position relative to
+    the body, in the body frame (fore-aft x for a swing, normal z for a lift), against
+    :func:`desired_phases` (controllers.hamr_leg.phase_errors_per_cycle, a lock-in per cycle)."""
+    from ..controllers.hamr_leg import phase_errors_per_cycle
+    rel = np.einsum("nji,nkj->nki", run["R"], run["feet"] - run["body"][:, None, :])     # R^T (foot - body)
+    legs = list(LEGS)
+    return {p: phase_errors_per_cycle(run["time"], rel[:, legs.index(p.split("_")[0]), FOOT_AXIS[p.split("_")[1]]],
+                                      run["frequency"], ph, cycles)
+            for p, ph in desired_phases().items()}
+
+
+def walk_closed_loop(system: System, frequency: float = LOOP_FREQUENCY, amplitude: float = LOOP_AMPLITUDE,
+                     cycles: int = LOOP_CYCLES, open_loop_cycles: int = OPEN_LOOP_CYCLES,
+                     measure_cycles: int = LOOP_MEASURE_CYCLES, estimator=None, gains: Optional[dict] = None) -> dict:
+    """Trot ``cycles`` cycles at ``frequency`` (Hz), ``amplitude`` (V) under
+    :class:`TrotPhaseControllers` (closed after ``open_loop_cycles``). Returns :func:`walk`'s
+    samples (its measuring window: the last ``measure_cycles``, for :func:`walk_metrics`) with
+    ``errors``: per actuator prefix the sensed and the true (:func:`foot_phase_errors`) phase
+    error per cycle (deg), the drive phase per cycle (deg) and the gains; and ``controller``."""
+    cycles = check_integer("cycles", cycles, 3, 10_000)
+    open_loop_cycles = check_integer("open_loop_cycles", open_loop_cycles, RAMP_CYCLES, cycles - 2,
+                                     f"at most cycles {cycles} - 2, so that a closed-loop cycle is measured")
+    measure_cycles = check_integer("measure_cycles", measure_cycles, 1, cycles - 1)
+    ctrl = TrotPhaseControllers(system, frequency, amplitude, open_loop_cycles, estimator, gains)
+    T = 1.0 / ctrl.frequency
+    run = walk(system, ctrl.frequency, amplitude, settle=(cycles - measure_cycles) * T, measure=measure_cycles * T,
+               controller=ctrl)
+    n = min(len(c.errors) for c in ctrl.ctrls.values())
+    true = foot_phase_errors(run, n)
+    run["errors"] = {p: {"sensed_deg": np.degrees(c.errors[:n]), "true_deg": true[p],
+                         "drive_phase_deg": np.degrees(c.commands[:n]), "gains": list(c.gains)}
+                     for p, c in ctrl.ctrls.items()}
+    run.update(controller=ctrl, open_loop_cycles=open_loop_cycles, closed_loop=True)
+    return run
+
+
+def loop_summary(run: dict, open_run: Optional[dict] = None, tol_deg: float = PHASE_TOL_DEG) -> dict:
+    """The read-outs of a :func:`walk_closed_loop`: per actuator the true phase error (deg)
+    in the last open-loop cycle and the last cycle, the cycles after closing until the true
+    and the sensed error stay within ``tol_deg`` (None: never), the largest |sensed - true|
+    (deg) over the cycles after the soft start; the walk metrics; and those of ``open_run``
+    (an open-loop :func:`walk` at the same drive) beside them."""
+    from ..controllers.hamr_leg import cycles_to_within
+    n_open = run["open_loop_cycles"]
+    act = {}
+    for p, e in run["errors"].items():
+        diff = np.angle(np.exp(1j * np.radians(e["sensed_deg"] - e["true_deg"])))[RAMP_CYCLES:]
+        act[p] = {"open_loop_error_deg": float(e["true_deg"][n_open - 1]), "final_error_deg": float(e["true_deg"][-1]),
+                  "cycles_to_tol": cycles_to_within(e["true_deg"], n_open, tol_deg),
+                  "cycles_to_tol_sensed": cycles_to_within(e["sensed_deg"], n_open, tol_deg),
+                  "max_sensed_minus_true_deg": float(np.degrees(np.abs(diff).max())),
+                  "gains_kp_ki_kd": e["gains"],
+                  "true_deg": [float(x) for x in e["true_deg"]], "sensed_deg": [float(x) for x in e["sensed_deg"]]}
+    m = walk_metrics(run)
+    m["upright"] = upright(m)
+    out = {"frequency_hz": run["frequency"], "amplitude_v": run["amplitude"], "open_loop_cycles": n_open,
+           "cycles": len(next(iter(run["errors"].values()))["true_deg"]) + 1, "tolerance_deg": tol_deg,
+           "actuators": act, "closed_loop": m,
+           "max_cycles_to_tol": None if any(a["cycles_to_tol"] is None for a in act.values())
+           else max(a["cycles_to_tol"] for a in act.values())}
+    if open_run is not None:
+        mo = walk_metrics(open_run)
+        mo["upright"] = upright(mo)
+        out["open_loop"] = mo
+    return out
 
 def segment_effect(segments: Sequence[int] = (2, SEGMENTS, 20), frequencies: Sequence[float] = (20.0, 65.0)) -> dict:
     """The single leg (hamr_leg.build, its design) with ``segments`` per actuator: each
