@@ -483,6 +483,28 @@ def loop_summary(run: dict, open_run: Optional[dict] = None, tol_deg: float = PH
         out["open_loop"] = mo
     return out
 
+
+def closed_loop_section(system: System, frequency: float = LOOP_FREQUENCY, amplitude: float = LOOP_AMPLITUDE,
+                        cycles: int = LOOP_CYCLES, out=None) -> dict:
+    """The command line's closed_loop section: :func:`walk_closed_loop` and the open-loop
+    :func:`walk` over the same cycles and window, :func:`loop_summary` of both, the
+    estimator's calibration; the closed-loop run recorded to ``out`` (None: not)."""
+    est = walker_estimator(system)
+    run = walk_closed_loop(system, frequency, amplitude, cycles, estimator=est)
+    T = 1.0 / frequency
+    open_run = walk(system, frequency, amplitude, settle=(cycles - LOOP_MEASURE_CYCLES) * T,
+                    measure=LOOP_MEASURE_CYCLES * T)
+    res = loop_summary(run, open_run)
+    res["estimator"] = dict(est.fit, bias_v=est.bias, calibrated_on="the free pzt-hamr-small (no leg), "
+                            f"{system.parts[0].layout.segments} segments")
+    if out:
+        write_recording(out, system, run)
+    res["recording"] = out
+    c, o = res["closed_loop"], res["open_loop"]
+    print(f"closed loop at {frequency:g} Hz, {amplitude:g} V: {c['speed_m_s']:.4g} m/s (open loop "
+          f"{o['speed_m_s']:.4g}); cycles to {PHASE_TOL_DEG:g} deg: {res['max_cycles_to_tol']}", file=sys.stderr)
+    return res
+
 def segment_effect(segments: Sequence[int] = (2, SEGMENTS, 20), frequencies: Sequence[float] = (20.0, 65.0)) -> dict:
     """The single leg (hamr_leg.build, its design) with ``segments`` per actuator: each
     transmission's foot gain (m/V, hamr_leg.sweep) at ``frequencies``, and the foot
@@ -585,7 +607,32 @@ def write_recording(path, system: System, run: dict) -> None:
                                 axis_x=x_axis(t)),
              rrb.TimeSeriesView(origin="/walk/clearance", name="foot clearance above the ground (m)",
                                 axis_y=y_axis(clearance), axis_x=x_axis(t)))
+    if "errors" in run:                          # a walk_closed_loop: its phase errors per cycle
+        extra, views = _with_phase_plots(run, extra, views)
     write_system_recording(path, run["result"], system, extra=extra, views=views, actuator_views=False)
+
+
+def _with_phase_plots(run: dict, extra, views) -> tuple:
+    """``extra`` and ``views`` of :func:`write_recording` with a closed-loop walk's phase
+    errors per cycle (deg): per actuator true (foot position) and sensed (own current)."""
+    import rerun as rr
+    import rerun.blueprint as rrb
+    f = run["frequency"]
+
+    def more(rec):
+        extra(rec)
+        for p, e in run["errors"].items():
+            t_cycle = (np.arange(len(e["true_deg"])) + 1) / f
+            for kind in ("true", "sensed"):
+                ent = f"walk/phase_error/{p}/{kind}"
+                rec.log(ent, rr.SeriesPoints(names=f"{p} {kind} phase error (deg)",
+                                             markers=["circle" if kind == "true" else "cross"]), static=True)
+                rec.send_columns(ent, indexes=[rr.TimeColumn("time", duration=t_cycle)],
+                                 columns=rr.Scalars.columns(scalars=np.asarray(e[f"{kind}_deg"], dtype=float)))
+
+    return more, views + (rrb.TimeSeriesView(origin="/walk/phase_error", name="foot phase error per cycle (deg): "
+                                             f"true (foot) and sensed (current), loops closed after "
+                                             f"{run['open_loop_cycles']} cycles"),)
 
 
 def model_summary(system: System) -> dict:
@@ -620,6 +667,15 @@ def main(argv=None):
                     help=f"drive amplitude about V_bias / 2 (V; {AMPLITUDE:g}: full, the signal swings 0..{BIAS:g} V)")
     ap.add_argument("--mu", type=arg_number(0.0, 10.0), default=MU, help="foot-ground friction coefficient")
     ap.add_argument("--segments", type=arg_integer(1, 40), default=SEGMENTS, help="segments per actuator")
+    ap.add_argument("--loop-frequency", type=arg_number(*FREQUENCY_RANGE, "Hz"), default=LOOP_FREQUENCY,
+                    help="the closed-loop trot's frequency (Hz)")
+    ap.add_argument("--loop-amplitude", type=arg_number(0.0, AMPLITUDE, "V", lo_open=True), default=LOOP_AMPLITUDE,
+                    help="the closed-loop trot's drive amplitude about V_bias / 2 (V)")
+    ap.add_argument("--loop-cycles", type=arg_integer(OPEN_LOOP_CYCLES + 2, 10_000), default=LOOP_CYCLES,
+                    help=f"cycles of the closed-loop trot, its {OPEN_LOOP_CYCLES} open-loop ones included")
+    ap.add_argument("--loop-out", default="out/hamr_walk_loop.rrd", type=arg_output(),
+                    help="recording of the closed-loop trot (.rrd)")
+    ap.add_argument("--no-closed-loop", action="store_true", help="skip the closed-loop trot")
     ap.add_argument("--quick", action="store_true",
                     help="skip the segment check and the incline search (at --record-frequency)")
     a = parse_args(ap, argv)
@@ -648,6 +704,8 @@ def main(argv=None):
     out["kinematic_check"] = {"frequency_hz": low["frequency_hz"], "speed_m_s": low["speed_m_s"],
                               "no_slip_estimate_m_s": k, "relative_error": None if not k else low["speed_m_s"] / k - 1.0}
     out["wall_s_per_simulated_s"] = float(np.mean([r["wall_s_per_simulated_s"] for r in out["runs"]]))
+    if not a.no_closed_loop:
+        out["closed_loop"] = closed_loop_section(system, a.loop_frequency, a.loop_amplitude, a.loop_cycles, a.loop_out)
     if not a.quick:
         out["segment_effect"] = segment_effect()
         out["incline"] = max_incline(a.record_frequency, a.amplitude, a.mu, a.segments)
