@@ -126,23 +126,28 @@ def phase_loop_gains(damping_ratio: float, resonance: float, frequency: float):
 class LegPhaseController:
     """Drives V = V_bias/2 + ``amplitude`` sin(2 pi ``frequency`` t + phi) (V) and, after
     ``open_loop_cycles`` cycles, moves phi once per cycle by a PID on the self-sensed phase
-    error. Reads only the drive's current (``drive.signals()``) and its own commands."""
+    error. Reads only the drive's current (``drive.signals()``) and its own commands.
+    ``initial_phase``: phi before the loop closes (rad); ``ramp``: the amplitude grows
+    linearly from zero over this many s (0: none), as the walker's soft start."""
 
     name = "leg phase PID (self-sensed)"
 
     def __init__(self, estimator: SelfSensingEstimator, frequency: float, amplitude: float,
-                 desired_phase: float = 0.0, gains=(0.7, 0.25, 0.0), open_loop_cycles: int = 10):
+                 desired_phase: float = 0.0, gains=(0.7, 0.25, 0.0), open_loop_cycles: int = 10,
+                 initial_phase: float = 0.0, ramp: float = 0.0):
         self.est = estimator
         self.frequency = check_positive("frequency", frequency, "Hz")
         self.amplitude = check_positive("amplitude", amplitude, "V")
         self.desired_phase, self.gains, self.open_loop_cycles = desired_phase, gains, int(open_loop_cycles)
+        self.initial_phase = float(initial_phase)
+        self.ramp = 0.0 if ramp == 0 else check_positive("ramp", ramp, "s")
 
     def reset(self, scene, drive) -> None:
         self.drive, self.dt = drive, scene.timestep
         self.interval = scene.timestep            # the drive is a sine: updated every step
         self.est.reset()
         self.est.bias = drive.params["bias"]
-        self.phi = 0.0
+        self.phi = self.initial_phase
         self._u: Optional[float] = None
         self._cycle, self._sum, self._n = 0, 0j, 0
         self._e = [0.0, 0.0]                      # the last two phase errors (rad)
@@ -172,7 +177,8 @@ class LegPhaseController:
             self._n += 1
         if t >= (self._cycle + 1) / self.frequency - 0.5 * self.dt:
             self._end_of_cycle()
-        self._u = self.est.bias / 2 + self.amplitude * np.sin(w * t + self.phi)
+        a = self.amplitude if t >= self.ramp else self.amplitude * t / self.ramp
+        self._u = self.est.bias / 2 + a * np.sin(w * t + self.phi)
         return self._u
 
     def signals(self) -> Dict[str, float]:

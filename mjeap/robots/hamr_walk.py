@@ -4,11 +4,14 @@ mjeap.robots.hamr_leg), trotting on a ground plane open loop at the paper's 200 
 
     mjeap robot hamr-walk [--out out/hamr_walk.rrd] [--frequencies 5 10 20 40 65 80 100]
         [--record-frequency 10] [--amplitude 100] [--mu 0.51] [--segments 4] [--quick]
+        [--loop-frequency 80] [--loop-amplitude 20] [--loop-cycles 40] [--loop-out ...] [--no-closed-loop]
 
 Prints JSON: per frequency the forward speed, the no-slip kinematic estimate, foot slip,
 body roll and pitch, penetration and wall time; the speed at 65 Hz beside the paper's
 0.5 m/s; the segment check and the steepest incline climbed at --record-frequency (not with
---quick). Writes a recording of the --record-frequency run. Written against mjeap's public
+--quick); the closed_loop section (the eight phase loops against the open loop at
+--loop-frequency, --loop-amplitude). Writes a recording of the --record-frequency run and
+one of the closed loop. Written against mjeap's public
 component API (attach, System, ContactParameters, add_transmission) and plain MjSpec.
 
 Model (host in mm, mg, ms; gravity along -z; x forward, y left, z up):
@@ -92,6 +95,15 @@ Findings (4 segments, mu 0.51; wall time 3.5-7 s per simulated second on 2 share
   right (mj_contactForce in mg mm / ms^2 = 1 mN); the peak is set by the numerical time
   constant, not a physical stiffness, and the plot samples the instantaneous force every
   2 ms, so it shows such a 20 us impact only when a sample falls in it.
+- Closed loop (:func:`walk_closed_loop`: the single leg's phase loops on all eight
+  actuators, each reading only its own drive current through the estimator calibrated on
+  the free actuator at 200 V and 4 segments; gains from phase_loop_gains at the trot
+  frequency; the transmissions' sweep on the 4-segment leg at 200 V fits 99.8 Hz and 79.8
+  Hz, zeta 0.052, the model's 100 / 80 Hz, 0.05): at 20 V, 80 Hz, open loop the feet lag
+  63-143 deg and the robot walks backward (-0.48 m/s over cycles 24-39); closed after 6
+  cycles it walks forward (+0.15 m/s), each foot's error averages within 8 deg, but
+  scatters 10-60 deg rms from cycle to cycle (the stance impacts and the body's bounce move
+  the foot relative to the body): no foot holds 5 deg.
 - Incline (the ground tilted, gravity along -z): full amplitude at 10 Hz climbs 4 deg, not
   8; 30 V at 20 Hz climbs 8, not 12 (the paper: nearly 22 deg).
 """
@@ -291,10 +303,11 @@ def _durations(frequency: float, settle: Optional[float], measure: Optional[floa
 
 def walk(system: System, frequency: float, amplitude: float = AMPLITUDE, settle: Optional[float] = None,
          measure: Optional[float] = None, samples_per_cycle: int = SAMPLES_PER_CYCLE,
-         lift_amplitude: Optional[float] = None) -> dict:
+         lift_amplitude: Optional[float] = None, controller=None) -> dict:
     """Trot open loop at ``frequency`` (Hz) for ``settle`` + ``measure`` s (defaults: whole
-    cycles, see SETTLE and MEASURE_*). Returns the samples (SI, world): time, body position
-    and rotation, the feet's positions and velocities, which feet touch the ground, the
+    cycles, see SETTLE and MEASURE_*), or under ``controller`` (a system controller, e.g.
+    :class:`TrotPhaseControllers`, see :func:`walk_closed_loop`). Returns the samples (SI,
+    world): time, body position and rotation, the feet's positions and velocities, which feet touch the ground, the
     deepest penetration; the rollout's result; the measuring window's start ``t0``."""
     bias = system.actuators[0].drive.params["bias"]
     settle, measure = _durations(frequency, settle, measure)
@@ -317,8 +330,9 @@ def walk(system: System, frequency: float, amplitude: float = AMPLITUDE, settle:
         rows["contact"].append([g in touching for g in fid])
         rows["penetration"].append(sy.penetration())
 
-    res = system.rollout(trot_voltages(frequency, amplitude, bias, lift_amplitude=lift_amplitude), settle + measure,
-                         sample_interval=1.0 / (samples_per_cycle * frequency), on_sample=on_sample)
+    volts = None if controller is not None else trot_voltages(frequency, amplitude, bias, lift_amplitude=lift_amplitude)
+    res = system.rollout(volts, settle + measure, sample_interval=1.0 / (samples_per_cycle * frequency),
+                         on_sample=on_sample, controller=controller)
     run = {k: np.array(v) for k, v in rows.items()}
     run.update(time=res.time[:len(rows["body"])], result=res, frequency=float(frequency), amplitude=float(amplitude),
                lift_amplitude=float(amplitude if lift_amplitude is None else lift_amplitude),
@@ -371,6 +385,180 @@ def walk_metrics(run: dict) -> dict:
         "wall_s_per_simulated_s": float(run["result"].meta["wall_time_s"] / t[-1]),
     }
 
+
+
+# ---- closed loop: the single leg's two phase loops on all eight actuators (issue 25) ----
+LOOP_FREQUENCY, LOOP_AMPLITUDE = 80.0, 20.0     # Hz, V: open loop the robot walks backward here (the lift lags)
+OPEN_LOOP_CYCLES = RAMP_CYCLES + 4              # cycles before the loops close (the soft start, then 4)
+LOOP_CYCLES = 40                                # cycles of a closed-loop walk, the open-loop ones included
+LOOP_MEASURE_CYCLES = 16                        # the walk metrics of a closed-loop walk: its last cycles
+PHASE_TOL_DEG = 5.0                             # deg, seed 003's "within 5 degrees"
+#: Hz, the free actuator's calibration sweep (as the single leg's free_estimator)
+ESTIMATOR_FREQUENCIES = (100.0, 1000.0, 1500.0, 1750.0, 2000.0)
+FOOT_AXIS = {"swing": 0, "lift": 2}             # the foot's body-frame coordinate: fore-aft x, normal z
+
+
+def desired_phases() -> dict:
+    """Per actuator prefix the desired phase (rad, against sin(omega t)) of its foot's
+    coordinate relative to the body (fore-aft for a swing, normal for a lift): the trot's,
+    as :func:`trot_voltages` drives it (each transmission moves its foot +x or +z for a
+    positive drive on either side)."""
+    return {f"{leg}_{dof}": phase + lead for leg, (_, _, phase) in LEGS.items()
+            for dof, lead in (("swing", 0.0), ("lift", 0.5 * np.pi))}
+
+
+def walker_estimator(system: System):
+    """Eqs. 7-9 calibrated once on the free pzt-hamr-small (no leg, no robot) at the
+    walker's bias and segments, as the single leg's free_estimator (its sweep frequencies,
+    ESTIMATOR_FREQUENCIES); not changed for the legs or the ground."""
+    from ..controllers.hamr_leg import free_actuator
+    from ..controllers.self_sensing import calibrate_on_free_actuator
+    a = system.actuators[0]
+    return calibrate_on_free_actuator(free_actuator(), a.drive.params["bias"], ESTIMATOR_FREQUENCIES, gravity=False,
+                                      segments=system.parts[0].layout.segments)
+
+
+def walk_loop_gains(frequency: float) -> dict:
+    """Per degree of freedom the phase loop's (kp, ki, kd) per cycle at the trot
+    ``frequency`` (Hz): controllers.hamr_leg.phase_loop_gains on the transmission's
+    second-order model (resonance 100 Hz swing, 80 Hz lift, damping ratio hamr_leg.ZETA)."""
+    from ..controllers.hamr_leg import phase_loop_gains
+    frequency = check_range("frequency", frequency, *FREQUENCY_RANGE, "Hz")
+    return {dof: phase_loop_gains(hamr_leg.ZETA, tr.resonance, frequency) for dof, tr in hamr_leg.DOFS.items()}
+
+
+class TrotPhaseControllers:
+    """The eight phase loops as one system controller: per actuator a
+    controllers.hamr_leg.LegPhaseController (the single leg's) driving V_bias/2 + a sin(omega t
+    + phi), phi starting at the trot's phase (:func:`desired_phases`), the amplitude ramped
+    over RAMP_CYCLES as the open-loop trot's; after ``open_loop_cycles`` phi moves once per
+    cycle by the PI on the sensed foot phase error. Each loop reads only its own actuator's
+    drive current (a drive observer stepped with the voltage it holds) through its own copy
+    of ``estimator`` (:func:`walker_estimator` if None); nothing else of the simulator."""
+
+    name = "eight foot phase PIs on the self-sensed currents"
+
+    def __init__(self, system: System, frequency: float, amplitude: float = LOOP_AMPLITUDE,
+                 open_loop_cycles: int = OPEN_LOOP_CYCLES, estimator=None, gains: Optional[dict] = None):
+        import copy
+        from ..controllers.hamr_leg import LegPhaseController
+        bias = system.actuators[0].drive.params["bias"]
+        frequency = check_range("frequency", frequency, *FREQUENCY_RANGE, "Hz")
+        amplitude = check_range("amplitude", amplitude, 0.0, 0.5 * bias, "V", lo_open=True)
+        open_loop_cycles = check_integer("open_loop_cycles", open_loop_cycles, RAMP_CYCLES, 10_000)
+        est = walker_estimator(system) if estimator is None else estimator
+        gains = walk_loop_gains(frequency) if gains is None else gains
+        self.frequency, self.open_loop_cycles, self.dt = frequency, open_loop_cycles, system.timestep
+        self.ctrls, self.obs = {}, {}
+        for prefix, phase in desired_phases().items():
+            c = LegPhaseController(copy.deepcopy(est), frequency, amplitude, phase, gains[prefix.split("_")[1]],
+                                   open_loop_cycles, initial_phase=phase, ramp=RAMP_CYCLES / frequency)
+            self.obs[prefix] = system.drive_observer(prefix)
+            c.reset(system, self.obs[prefix])
+            self.ctrls[prefix] = c
+
+    def __call__(self, t: float, system: System) -> dict:
+        out = {}
+        for prefix, c in self.ctrls.items():
+            out[prefix] = c(t, None)            # reads the current after the last step, nothing of the system
+            self.obs[prefix].step(out[prefix], self.dt)
+        return out
+
+
+def foot_phase_errors(run: dict, cycles: int) -> dict:
+    """Per actuator prefix the true phase error (deg) of its foot per drive cycle, for the
+    first ``cycles`` cycles of a :func:`walk`: the foot's simulated 3D position relative to
+    the body, in the body frame (fore-aft x for a swing, normal z for a lift), against
+    :func:`desired_phases` (controllers.hamr_leg.phase_errors_per_cycle, a lock-in per cycle)."""
+    from ..controllers.hamr_leg import phase_errors_per_cycle
+    rel = np.einsum("nji,nkj->nki", run["R"], run["feet"] - run["body"][:, None, :])     # R^T (foot - body)
+    legs = list(LEGS)
+    return {p: phase_errors_per_cycle(run["time"], rel[:, legs.index(p.split("_")[0]), FOOT_AXIS[p.split("_")[1]]],
+                                      run["frequency"], ph, cycles)
+            for p, ph in desired_phases().items()}
+
+
+def walk_closed_loop(system: System, frequency: float = LOOP_FREQUENCY, amplitude: float = LOOP_AMPLITUDE,
+                     cycles: int = LOOP_CYCLES, open_loop_cycles: int = OPEN_LOOP_CYCLES,
+                     measure_cycles: int = LOOP_MEASURE_CYCLES, estimator=None, gains: Optional[dict] = None) -> dict:
+    """Trot ``cycles`` cycles at ``frequency`` (Hz), ``amplitude`` (V) under
+    :class:`TrotPhaseControllers` (closed after ``open_loop_cycles``). Returns :func:`walk`'s
+    samples (its measuring window: the last ``measure_cycles``, for :func:`walk_metrics`) with
+    ``errors``: per actuator prefix the sensed and the true (:func:`foot_phase_errors`) phase
+    error per cycle (deg), the drive phase per cycle (deg) and the gains; and ``controller``."""
+    cycles = check_integer("cycles", cycles, 3, 10_000)
+    open_loop_cycles = check_integer("open_loop_cycles", open_loop_cycles, RAMP_CYCLES, cycles - 2,
+                                     f"at most cycles {cycles} - 2, so that a closed-loop cycle is measured")
+    measure_cycles = check_integer("measure_cycles", measure_cycles, 1, cycles - 1)
+    ctrl = TrotPhaseControllers(system, frequency, amplitude, open_loop_cycles, estimator, gains)
+    T = 1.0 / ctrl.frequency
+    run = walk(system, ctrl.frequency, amplitude, settle=(cycles - measure_cycles) * T, measure=measure_cycles * T,
+               controller=ctrl)
+    n = min(len(c.errors) for c in ctrl.ctrls.values())
+    true = foot_phase_errors(run, n)
+    run["errors"] = {p: {"sensed_deg": np.degrees(c.errors[:n]), "true_deg": true[p],
+                         "drive_phase_deg": np.degrees(c.commands[:n]), "gains": list(c.gains)}
+                     for p, c in ctrl.ctrls.items()}
+    run.update(controller=ctrl, open_loop_cycles=open_loop_cycles, closed_loop=True)
+    return run
+
+
+def loop_summary(run: dict, open_run: Optional[dict] = None, tol_deg: float = PHASE_TOL_DEG) -> dict:
+    """The read-outs of a :func:`walk_closed_loop`: per actuator the true phase error (deg)
+    in the last open-loop cycle and the last cycle, the cycles after closing until the true
+    and the sensed error stay within ``tol_deg`` (None: never), the largest |sensed - true|
+    (deg) over the cycles after the soft start and its mean; the true error's mean and rms
+    from 10 cycles after closing (None if the run is shorter); the walk metrics; and those of ``open_run``
+    (an open-loop :func:`walk` at the same drive) beside them."""
+    from ..controllers.hamr_leg import cycles_to_within
+    n_open = run["open_loop_cycles"]
+    act = {}
+    for p, e in run["errors"].items():
+        diff = np.angle(np.exp(1j * np.radians(e["sensed_deg"] - e["true_deg"])))[RAMP_CYCLES:]
+        tail = np.asarray(e["true_deg"])[n_open + 10:]          # from 10 cycles after the loops close
+        act[p] = {"open_loop_error_deg": float(e["true_deg"][n_open - 1]), "final_error_deg": float(e["true_deg"][-1]),
+                  "cycles_to_tol": cycles_to_within(e["true_deg"], n_open, tol_deg),
+                  "cycles_to_tol_sensed": cycles_to_within(e["sensed_deg"], n_open, tol_deg),
+                  "max_sensed_minus_true_deg": float(np.degrees(np.abs(diff).max())),
+                  "mean_sensed_minus_true_deg": float(np.degrees(diff.mean())),
+                  "settled_mean_error_deg": float(np.mean(tail)) if tail.size else None,
+                  "settled_rms_error_deg": float(np.sqrt(np.mean(tail ** 2))) if tail.size else None,
+                  "gains_kp_ki_kd": e["gains"],
+                  "true_deg": [float(x) for x in e["true_deg"]], "sensed_deg": [float(x) for x in e["sensed_deg"]]}
+    m = walk_metrics(run)
+    m["upright"] = upright(m)
+    out = {"frequency_hz": run["frequency"], "amplitude_v": run["amplitude"], "open_loop_cycles": n_open,
+           "cycles": len(next(iter(run["errors"].values()))["true_deg"]) + 1, "tolerance_deg": tol_deg,
+           "actuators": act, "closed_loop": m,
+           "max_cycles_to_tol": None if any(a["cycles_to_tol"] is None for a in act.values())
+           else max(a["cycles_to_tol"] for a in act.values())}
+    if open_run is not None:
+        mo = walk_metrics(open_run)
+        mo["upright"] = upright(mo)
+        out["open_loop"] = mo
+    return out
+
+
+def closed_loop_section(system: System, frequency: float = LOOP_FREQUENCY, amplitude: float = LOOP_AMPLITUDE,
+                        cycles: int = LOOP_CYCLES, out=None) -> dict:
+    """The command line's closed_loop section: :func:`walk_closed_loop` and the open-loop
+    :func:`walk` over the same cycles and window, :func:`loop_summary` of both, the
+    estimator's calibration; the closed-loop run recorded to ``out`` (None: not)."""
+    est = walker_estimator(system)
+    run = walk_closed_loop(system, frequency, amplitude, cycles, estimator=est)
+    T = 1.0 / frequency
+    open_run = walk(system, frequency, amplitude, settle=(cycles - LOOP_MEASURE_CYCLES) * T,
+                    measure=LOOP_MEASURE_CYCLES * T)
+    res = loop_summary(run, open_run)
+    res["estimator"] = dict(est.fit, bias_v=est.bias, calibrated_on="the free pzt-hamr-small (no leg), "
+                            f"{system.parts[0].layout.segments} segments")
+    if out:
+        write_recording(out, system, run)
+    res["recording"] = out
+    c, o = res["closed_loop"], res["open_loop"]
+    print(f"closed loop at {frequency:g} Hz, {amplitude:g} V: {c['speed_m_s']:.4g} m/s (open loop "
+          f"{o['speed_m_s']:.4g}); cycles to {PHASE_TOL_DEG:g} deg: {res['max_cycles_to_tol']}", file=sys.stderr)
+    return res
 
 def segment_effect(segments: Sequence[int] = (2, SEGMENTS, 20), frequencies: Sequence[float] = (20.0, 65.0)) -> dict:
     """The single leg (hamr_leg.build, its design) with ``segments`` per actuator: each
@@ -474,7 +662,32 @@ def write_recording(path, system: System, run: dict) -> None:
                                 axis_x=x_axis(t)),
              rrb.TimeSeriesView(origin="/walk/clearance", name="foot clearance above the ground (m)",
                                 axis_y=y_axis(clearance), axis_x=x_axis(t)))
+    if "errors" in run:                          # a walk_closed_loop: its phase errors per cycle
+        extra, views = _with_phase_plots(run, extra, views)
     write_system_recording(path, run["result"], system, extra=extra, views=views, actuator_views=False)
+
+
+def _with_phase_plots(run: dict, extra, views) -> tuple:
+    """``extra`` and ``views`` of :func:`write_recording` with a closed-loop walk's phase
+    errors per cycle (deg): per actuator true (foot position) and sensed (own current)."""
+    import rerun as rr
+    import rerun.blueprint as rrb
+    f = run["frequency"]
+
+    def more(rec):
+        extra(rec)
+        for p, e in run["errors"].items():
+            t_cycle = (np.arange(len(e["true_deg"])) + 1) / f
+            for kind in ("true", "sensed"):
+                ent = f"walk/phase_error/{p}/{kind}"
+                rec.log(ent, rr.SeriesPoints(names=f"{p} {kind} phase error (deg)",
+                                             markers=["circle" if kind == "true" else "cross"]), static=True)
+                rec.send_columns(ent, indexes=[rr.TimeColumn("time", duration=t_cycle)],
+                                 columns=rr.Scalars.columns(scalars=np.asarray(e[f"{kind}_deg"], dtype=float)))
+
+    return more, views + (rrb.TimeSeriesView(origin="/walk/phase_error", name="foot phase error per cycle (deg): "
+                                             f"true (foot) and sensed (current), loops closed after "
+                                             f"{run['open_loop_cycles']} cycles"),)
 
 
 def model_summary(system: System) -> dict:
@@ -509,6 +722,15 @@ def main(argv=None):
                     help=f"drive amplitude about V_bias / 2 (V; {AMPLITUDE:g}: full, the signal swings 0..{BIAS:g} V)")
     ap.add_argument("--mu", type=arg_number(0.0, 10.0), default=MU, help="foot-ground friction coefficient")
     ap.add_argument("--segments", type=arg_integer(1, 40), default=SEGMENTS, help="segments per actuator")
+    ap.add_argument("--loop-frequency", type=arg_number(*FREQUENCY_RANGE, "Hz"), default=LOOP_FREQUENCY,
+                    help="the closed-loop trot's frequency (Hz)")
+    ap.add_argument("--loop-amplitude", type=arg_number(0.0, AMPLITUDE, "V", lo_open=True), default=LOOP_AMPLITUDE,
+                    help="the closed-loop trot's drive amplitude about V_bias / 2 (V)")
+    ap.add_argument("--loop-cycles", type=arg_integer(OPEN_LOOP_CYCLES + 2, 10_000), default=LOOP_CYCLES,
+                    help=f"cycles of the closed-loop trot, its {OPEN_LOOP_CYCLES} open-loop ones included")
+    ap.add_argument("--loop-out", default="out/hamr_walk_loop.rrd", type=arg_output(),
+                    help="recording of the closed-loop trot (.rrd)")
+    ap.add_argument("--no-closed-loop", action="store_true", help="skip the closed-loop trot")
     ap.add_argument("--quick", action="store_true",
                     help="skip the segment check and the incline search (at --record-frequency)")
     a = parse_args(ap, argv)
@@ -537,6 +759,8 @@ def main(argv=None):
     out["kinematic_check"] = {"frequency_hz": low["frequency_hz"], "speed_m_s": low["speed_m_s"],
                               "no_slip_estimate_m_s": k, "relative_error": None if not k else low["speed_m_s"] / k - 1.0}
     out["wall_s_per_simulated_s"] = float(np.mean([r["wall_s_per_simulated_s"] for r in out["runs"]]))
+    if not a.no_closed_loop:
+        out["closed_loop"] = closed_loop_section(system, a.loop_frequency, a.loop_amplitude, a.loop_cycles, a.loop_out)
     if not a.quick:
         out["segment_effect"] = segment_effect()
         out["incline"] = max_incline(a.record_frequency, a.amplitude, a.mu, a.segments)
