@@ -89,13 +89,16 @@ def metric_max_tip_deflection(r, point, scene) -> float:
 
 def metric_estimated_error(r, point, scene) -> str:
     """With an ``accuracy`` target: the estimated error of the tip curvature relative to its
-    swing and the model chosen for it, e.g. '0.0031 (12 segments, discrete, h = 0.00333 s)'
-    (:mod:`mjeap.simulation.accuracy`); '' without one."""
+    swing and the model chosen for it, e.g. '0.0031 (12 segments, discrete, h = 0.00333 s;
+    pilots)' (:mod:`mjeap.simulation.accuracy`), 'shared error model' where the point started
+    from its family's (:func:`run_sweep`); '' without one."""
     a = r.meta.get("accuracy")
     if not a:
         return ""
     m = a["model"]
-    return f"{a['estimated_error']:.3g} ({m['segments']} segments, {m['integrator']}, h = {m['timestep']:.3g} s)"
+    how = "shared error model" if any(x["role"] == "spatial companion" for x in a.get("runs", ())) else "pilots"
+    return (f"{a['estimated_error']:.3g} ({m['segments']} segments, {m['integrator']}, h = {m['timestep']:.3g} s; "
+            f"{how}, {a.get('refinements', 0)} refinements)")
 
 
 METRICS: Dict[str, Callable] = {
@@ -183,10 +186,12 @@ def check_settings(points: Sequence[dict], base: Optional[dict]) -> None:
 
 # ---------------------------------------------------------------- one point
 def evaluate(point: dict, metrics: Sequence[str] = ("peak_to_peak", "returns"), base: Optional[dict] = None,
-             rrd_dir: Optional[str] = None) -> dict:
+             rrd_dir: Optional[str] = None, error_model=None) -> dict:
     """Run one point (``base`` filled in under it) and return its row: the parameters, the
     metrics, ``error`` (empty when it ran), ``wall_s`` and ``point_id``. Never raises for a
-    failing point."""
+    failing point. At an accuracy target, ``error_model`` (a, b) replaces the point's pilots
+    (:func:`mjeap.simulation.accuracy.run_at_accuracy`) and the row's ``_error_model`` (not
+    a CSV column) holds the constants the point ran with."""
     from .model.discretize import Payload
     from .simulation.rollout import rollout
     from .simulation.scene import Scene
@@ -218,7 +223,11 @@ def evaluate(point: dict, metrics: Sequence[str] = ("peak_to_peak", "returns"), 
         drive_params = {k[6:]: v for k, v in p.items() if k.startswith("drive.")}
         rrd = None if rrd_dir is None else Path(rrd_dir) / f"point-{row['point_id']}.rrd"
         r = rollout(scene, wave, float(duration), drive_params=drive_params, initial_curvature=float(p["initial_curvature"]),
-                    progress=False, rrd=rrd, engine=p["engine"])
+                    progress=False, rrd=rrd, engine=p["engine"],
+                    error_model=error_model if scene.accuracy is not None else None)
+        if "accuracy" in r.meta:
+            e = r.meta["accuracy"].get("error_model")
+            row["_error_model"] = None if e is None else (e["spatial_a"], e["temporal_b_per_s"])
         for m in metrics:
             row[m] = METRICS[m](r, p, scene)
     except MjeapError as e:
@@ -316,6 +325,45 @@ def _one_blas_thread() -> None:
     threadpool_limits(1)
 
 
+#: parameters that change the size of a point's loads, not the kind of its question: points
+#: that differ only in these share one accuracy error model (:func:`_with_shared_error_models`)
+LOAD_SIZE = ("payload_mass", "amplitude", "offset", "initial_curvature")
+
+
+def _family(job) -> Optional[str]:
+    """The accuracy family of a job: its parameters less LOAD_SIZE, or None without a target."""
+    p = {**PARAMETERS, **(job[2] or {}), **job[0]}
+    if p["accuracy"] in (None, ""):
+        return None
+    return json.dumps({k: v for k, v in p.items() if k not in LOAD_SIZE}, sort_keys=True, default=float)
+
+
+def _with_shared_error_models(executor: str, workers: int, scheduler: Optional[str], jobs):
+    """Yield finished rows. At an accuracy target the first point of each family (the same
+    question but for LOAD_SIZE) runs first with its own pilots; the family's other points
+    start from its error model (a, b) instead of pilots of their own, their error still
+    measured on each (:func:`mjeap.simulation.accuracy.run_at_accuracy`). Points of a
+    family whose first point failed run their own pilots."""
+    leads, rest, seen = [], [], set()
+    for job in jobs:
+        key = _family(job)
+        if key is not None and key not in seen:
+            seen.add(key)
+            leads.append(job)
+        else:
+            rest.append((key, job))
+    if not leads:
+        yield from _submit_all(executor, workers, scheduler, jobs)
+        return
+    lead_family = {point_id(j[0], j[2], j[1]): _family(j) for j in leads}
+    models = {}
+    for row in _submit_all(executor, workers, scheduler, leads):
+        models[lead_family[row["point_id"]]] = row.get("_error_model")
+        yield row
+    yield from _submit_all(executor, workers, scheduler,
+                           [tuple(job[:4]) + (models.get(key),) for key, job in rest])
+
+
 def _submit_all(executor: str, workers: int, scheduler: Optional[str], jobs):
     """Yield finished rows as they complete."""
     if executor == "serial":
@@ -411,10 +459,13 @@ def _run_processes(jobs: list, workers: int):
 def run_sweep(points: Sequence[dict], path, metrics: Sequence[str] = ("peak_to_peak", "returns"),
               base: Optional[dict] = None, executor: str = "processes", workers: int = 2,
               scheduler: Optional[str] = None, record: Sequence[int] = (), rrd_dir=None,
-              progress: Optional[bool] = None) -> SweepSummary:
+              progress: Optional[bool] = None, share_error_models: bool = True) -> SweepSummary:
     """Evaluate ``points`` and stream one CSV row per finished point to ``path``. Points
     already in the file (same ``point_id``) are skipped. ``record``: indices of points
-    that also write a recording to ``rrd_dir`` (default: next to the CSV)."""
+    that also write a recording to ``rrd_dir`` (default: next to the CSV).
+    ``share_error_models`` (at an accuracy target): points differing only in LOAD_SIZE
+    start from their family's first point's error model instead of pilots of their own
+    (:func:`_with_shared_error_models`); each point's error is measured on it either way."""
     path = Path(path)
     if executor not in EXECUTORS:
         raise ParameterError("executor", executor, f"one of {', '.join(EXECUTORS)}")
@@ -436,10 +487,11 @@ def run_sweep(points: Sequence[dict], path, metrics: Sequence[str] = ("peak_to_p
     # the CSV's lock for the whole sweep (PATH.lock): a second sweep on it, or a run writing it,
     # is refused (it would compute every point twice and duplicate rows)
     with hold(path, "path", holder="mjeap sweep"):
-        return _run_locked(points, path, metrics, base, executor, workers, scheduler, record, rrd_dir, progress)
+        return _run_locked(points, path, metrics, base, executor, workers, scheduler, record, rrd_dir, progress,
+                           bool(share_error_models))
 
 
-def _run_locked(points, path, metrics, base, executor, workers, scheduler, record, rrd_dir, progress):
+def _run_locked(points, path, metrics, base, executor, workers, scheduler, record, rrd_dir, progress, share=True):
     _drop_torn_row(path)
     done_ids = set()
     if path.exists() and path.stat().st_size > 0:
@@ -466,10 +518,10 @@ def _run_locked(points, path, metrics, base, executor, workers, scheduler, recor
             bar = None
     t0 = time.perf_counter()
     with sigterm_as_interrupt():
-        return _write_rows(path, columns, new_file, executor, workers, scheduler, jobs, bar, skipped, t0)
+        return _write_rows(path, columns, new_file, executor, workers, scheduler, jobs, bar, skipped, t0, share)
 
 
-def _write_rows(path, columns, new_file, executor, workers, scheduler, jobs, bar, skipped, t0):
+def _write_rows(path, columns, new_file, executor, workers, scheduler, jobs, bar, skipped, t0, share=True):
     failed, done = 0, 0
     with open(path, "a", newline="") as fh:
         w = csvio.writer(fh)
@@ -477,7 +529,8 @@ def _write_rows(path, columns, new_file, executor, workers, scheduler, jobs, bar
             w.writerow(columns)
             fh.flush()
         try:
-            for row in _submit_all(executor, int(workers), scheduler, jobs):
+            rows = _with_shared_error_models if share else _submit_all
+            for row in rows(executor, int(workers), scheduler, jobs):
                 w.writerow([row.get(k, "") for k in columns])
                 fh.flush()
                 os.fsync(fh.fileno())

@@ -409,7 +409,7 @@ def bench_accuracy(claim_cases=12):
     from mjeap.simulation.accuracy import relative_difference
     from mjeap.drives import make_drive
     from mjeap.analysis.stability import MAP_BASE
-    from mjeap.sweep import grid, run_sweep
+    from mjeap.sweep import grid, read_results, run_sweep
     from mjeap.validation.accuracy_claim import check_case, draw_cases, summarise
     wave, args = "square:1.5V@0.1Hz", dict(initial_curvature=-303.0, progress=False)
     s = Scene("pedot-micro", orientation="up", payload="12.6mg@6.27mm")
@@ -447,9 +447,14 @@ def bench_accuracy(claim_cases=12):
     pts = grid(payload_mass=list(np.linspace(15e-6, 120e-6, 4)), amplitude=[0.5, 1.5])
     import tempfile
     with tempfile.TemporaryDirectory() as d:
-        for label, extra in (("default", {}), ("accuracy_1e-2", {"accuracy": 1e-2})):
-            res = run_sweep(pts, Path(d) / f"{label}.csv", base={**MAP_BASE, **extra}, workers=2, progress=False)
+        for label, extra, share in (("default", {}, True), ("accuracy_1e-2_pilots_per_point", {"accuracy": 1e-2}, False),
+                                    ("accuracy_1e-2", {"accuracy": 1e-2}, True)):
+            res = run_sweep(pts, Path(d) / f"{label}.csv", metrics=("returns", "peak_to_peak"),
+                            base={**MAP_BASE, **extra}, workers=2, progress=False, share_error_models=share)
+            rows = read_results(Path(d) / f"{label}.csv")
             out[f"stability_map_{label}_points_per_s"] = res.throughput
+            out[f"stability_map_{label}_returns"] = {f"{float(r['payload_mass']) * 1e6:.1f} mg, {r['amplitude']} V":
+                                                     r["returns"] for r in rows}
     nat = s.native_model(make_drive(None, s))
     nat.reset(-303.0)
     out["native_step_phases"] = {"nv": nat.model.nv, "nbody": nat.model.nbody, **_step_phases(nat.model, nat.data)}

@@ -111,3 +111,42 @@ def test_the_accuracy_claim_on_seeded_cases():
     assert s["estimate_within_3x"] >= 0.9, detail
     assert s["estimate_over_true_range"][0] >= 1 / 3, detail         # never an estimate 3 x too low
     assert ACCURACY_RANGE[0] <= min(r["target"] for r in rows)
+
+
+def test_a_given_error_model_replaces_the_pilots_and_the_error_is_still_measured():
+    """A prior (a, b) from elsewhere only chooses the first model: the run has no pilots, the
+    segments' error is measured on the question (a spatial companion). Priors 4 x off the
+    question's own pilots in opposite directions, (4 a, b / 4) and (a / 4, 4 b): the true
+    error (against 40 segments at 1/4 of the finest step, discrete) stays below the target
+    and the estimate within 3 x of it, never 3 x too low, as with the pilots."""
+    from mjeap.drives import make_drive
+    from mjeap.simulation.accuracy import relative_difference
+    s = Scene("pedot-micro", **FAST)
+    wave, T, target = "sine:1V@5Hz", 0.2, 3e-3
+    own = rollout(s, wave, T, accuracy=target)
+    a, b = own.meta["accuracy"]["error_model"]["spatial_a"], own.meta["accuracy"]["error_model"]["temporal_b_per_s"]
+    runs = [own] + [rollout(s, wave, T, accuracy=target, error_model=p) for p in ((4 * a, b / 4), (a / 4, 4 * b))]
+    h = min(r.meta["accuracy"]["model"]["timestep"] for r in runs) / 4
+    ref_scene = s.variant(40, h, "discrete")
+    interval = float(runs[0].time[1] - runs[0].time[0])
+    ref = rollout(ref_scene, wave, T, drive=make_drive(None, ref_scene), sample_interval=interval)
+    for r in runs[1:]:
+        acc = r.meta["accuracy"]
+        roles = [x["role"] for x in acc["runs"]]
+        assert "pilot" not in roles and "spatial companion" in roles
+        assert "given" in acc["error_model"]["pilots"]
+    for r in runs:
+        true, est = relative_difference(ref, r), r.meta["accuracy"]["estimated_error"]
+        assert true <= target, (r.meta["accuracy"]["model"], true)
+        assert 1 / 3 <= est / true <= 3, (r.meta["accuracy"]["model"], true, est)
+
+
+@pytest.mark.parametrize("bad", [(-1.0, 1.0), (1.0, float("nan")), "ab", 3.0])
+def test_a_bad_error_model_is_refused_naming_it(bad):
+    with pytest.raises(ParameterError, match="error_model"):
+        rollout(Scene("pedot-micro", **FAST), "step:1V", 0.01, accuracy=1e-2, error_model=bad)
+
+
+def test_an_error_model_without_a_target_is_refused():
+    with pytest.raises(ParameterError, match="error_model"):
+        rollout(Scene("pedot-micro", **FAST), "step:1V", 0.01, error_model=(0.1, 1.0))

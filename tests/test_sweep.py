@@ -70,3 +70,31 @@ def test_bad_sweep_input():
         run_sweep(POINTS, "/tmp/never.csv", workers=0, progress=False)
     with pytest.raises(ParameterError, match="executor"):
         run_sweep(POINTS[:1], "/tmp/never-exec.csv", base=BASE, executor="mpi", progress=False)
+
+
+def test_at_a_target_a_family_shares_its_first_points_error_model(tmp_path):
+    """Points differing only in load sizes (amplitude here) start from the first one's error
+    model (no pilots of their own, the row says so); another actuator is another family.
+    Each point's estimated error is measured on it and meets the target, and the outcome is
+    the one of pilots per point."""
+    from mjeap.sweep import _family
+    base = {"actuator": "pedot-micro", "orientation": "horizontal", "waveform": "sine", "frequency": 5.0,
+            "duration": 0.2, "accuracy": 3e-3}
+    pts = [{"amplitude": a} for a in (0.5, 1.0, 1.5)]
+    jobs = [(p, ("peak_to_peak",), base, None) for p in pts]
+    assert len({_family(j) for j in jobs}) == 1
+    assert _family(({"actuator": "ppy-mutlu", "amplitude": 1.0}, (), base, None)) != _family(jobs[0])
+    assert _family(({"amplitude": 1.0}, (), {**base, "accuracy": None}, None)) is None
+    rows = {}
+    for share in (True, False):
+        path = tmp_path / f"share{share}.csv"
+        run_sweep(pts, path, metrics=("peak_to_peak", "estimated_error"), base=base, executor="serial",
+                  share_error_models=share)
+        rows[share] = read_results(path)
+    shared = [r["estimated_error"] for r in rows[True]]
+    assert sum("shared error model" in e for e in shared) == 2 and "pilots" in shared[0]
+    assert all("pilots" in r["estimated_error"] for r in rows[False])
+    for a, b in zip(rows[True], rows[False]):
+        assert float(a["estimated_error"].split()[0]) <= 3e-3 and float(b["estimated_error"].split()[0]) <= 3e-3
+        # each run's curvature within 3e-3 of the swing: each peak-to-peak within 2 x that, the two within 4 x
+        assert float(a["peak_to_peak"]) == pytest.approx(float(b["peak_to_peak"]), rel=4 * 3e-3)

@@ -41,7 +41,7 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
             csv_path: Union[str, Path, None] = None, sample_interval: Optional[float] = None,
             progress: Optional[bool] = None, check_every: int = 100, controller=None,
             engine: str = "auto", max_steps: Optional[int] = None, accuracy: Optional[float] = None,
-            estimate_error: bool = False) -> RolloutResult:
+            estimate_error: bool = False, error_model=None) -> RolloutResult:
     """Run ``scene`` driven by ``drive`` (name, instance or None for the actuator's own)
     with ``voltage`` (waveform text, :class:`Waveform` or callable v(t)) for ``duration`` s.
 
@@ -61,6 +61,9 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     (:mod:`mjeap.simulation.accuracy`; ``scene`` is left as it was) and ``meta['accuracy']`` carries the
     model and its estimated error. Without one the scene's model runs; ``estimate_error``
     then estimates its error with a coarser companion run (about 0.35 x the cost).
+    ``error_model`` (with a target): the constants (a, b) of a similar question's run, its
+    ``meta['accuracy']['error_model']``, in place of this run's pilots
+    (:func:`mjeap.simulation.accuracy.run_at_accuracy`).
     """
     from ..drives import make_drive
     from ..io import recording
@@ -71,9 +74,15 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     drv = drive if (drive is not None and not isinstance(drive, str)) else \
         make_drive(drive, scene, **(drive_params or {}))
     target = target_for(scene, accuracy)
+    if error_model is not None:
+        from .accuracy import as_error_model
+        as_error_model(error_model)
+        if target is None:
+            raise ParameterError("error_model", error_model, "None without an accuracy target (it chooses the model "
+                                 "for one)")
     if target is not None or estimate_error:
         return _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, csv_path, sample_interval,
-                                    check_every, controller, engine, max_steps, target, wave)
+                                    check_every, controller, engine, max_steps, target, wave, error_model)
     eng, engine_reason = choose(engine, scene, drv, controller)
     dt = scene.timestep
     v_steps = voltage_steps(wave, duration, dt, drv, max_steps)
@@ -112,7 +121,7 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
 
 
 def _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, csv_path, sample_interval,
-                         check_every, controller, engine, max_steps, target, wave) -> RolloutResult:
+                         check_every, controller, engine, max_steps, target, wave, error_model=None) -> RolloutResult:
     """:func:`rollout` at an accuracy target (or, without one, with its error estimated): the
     runs of :mod:`mjeap.simulation.accuracy`, each with the drive ``drv`` names and its parameters;
     the outputs hold the chosen run, whose meta says how it was chosen."""
@@ -132,7 +141,7 @@ def _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, 
         acc.estimate_error(scene, run, result, duration=duration, sample_interval=sample_interval)
     else:
         result, chosen, _ = acc.run_at_accuracy(scene, run, accuracy=target, duration=duration, wave=wave,
-                                                sample_interval=sample_interval)
+                                                sample_interval=sample_interval, error_model=error_model)
     writers = []
     if rrd is not None:
         writers.append((rrd, lambda: recording.write_recording(rrd, result, chosen)))

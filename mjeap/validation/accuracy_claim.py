@@ -83,12 +83,13 @@ def draw_cases(seed: int, n: int) -> List[Case]:
     return cases
 
 
-def check_case(case: Case) -> dict:
-    """Run ``case`` at its target and against a converged run: the true error, the
-    estimate, the model and the walls."""
+def check_case(case: Case, error_model=None) -> dict:
+    """Run ``case`` at its target (starting from ``error_model`` (a, b) instead of pilots, if
+    given) and against a converged run: the true error, the estimate, the model and the
+    walls."""
     scene = Scene(case.actuator, orientation=case.orientation, payload=case.payload)
     t0 = _time.perf_counter()
-    r = rollout(scene, case.voltage, case.duration, accuracy=case.target)
+    r = rollout(scene, case.voltage, case.duration, accuracy=case.target, error_model=error_model)
     wall = _time.perf_counter() - t0
     a = r.meta["accuracy"]
     m = a["model"]
@@ -100,6 +101,7 @@ def check_case(case: Case) -> dict:
     ref = rollout(ref_scene, case.voltage, case.duration, drive=make_drive(None, ref_scene), sample_interval=interval)
     true = relative_difference(ref, r)
     return {"case": case.describe(), **asdict(case), "model": m, "estimated_error": a["estimated_error"],
+            "error_model": (a["error_model"]["spatial_a"], a["error_model"]["temporal_b_per_s"]),
             "true_error": true, "below_target": true <= case.target, "within_2x": true <= 2 * case.target,
             "estimate_over_true": a["estimated_error"] / true if true > 0 else math.inf,
             "runs": len(a["runs"]), "wall_s": wall, "reference": f"{n_ref} segments at {h_ref:.4g} s",
