@@ -61,51 +61,74 @@ feet's backward speed relative to the body (foot path in the body frame), i.e. w
 body would move if no stance foot slid; also the stance stroke, duty factor, stroke x f /
 duty.
 
-Findings (4 segments, mu 0.51; wall time 3.5-7 s per simulated second on 2 shared cores):
+Findings (4 segments, mu 0.51, MuJoCo 4.0; wall time 3.5-7 s per simulated second on 2
+shared cores). Re-measured after the fix of hamr_leg.add_leg's swing-stage and lift-lever
+centres of mass (commit 41b82c0: before it the robot's swing joints carried twice the
+design inertia, swing resonance 71 Hz, not 100), with :func:`walk` and :func:`walk_metrics`
+at their default windows; the motion is chaotic (a small change of mu or segments moves
+these numbers), so they are single runs, not converged values:
 - Full amplitude (the paper's drive): the feet move T x delta(200 V) = 3.5 mm (swing) and
   3.2 mm (lift) quasi-statically on a 10 mm leg, 6.1 and 9.4 mm at 65 Hz (dynamic gains 1.7
-  and 2.9). The robot trots upright only at 5-10 Hz (0.079 and 0.092 m/s, roll and pitch
-  8-13 deg, the body rocking on its diagonal support and hopping on its legs' lift
-  compliance: k_foot = m_foot (2 pi 80 Hz)^2 = 9 N/m, the body bounces at 18 Hz on two
-  feet, 25 Hz on four, damped to zeta ~0.01); 75-85 % of the stance samples slide and the
-  speed is 0-20 % off the no-slip estimate depending on details (mu 0.50 or 0.52, 3 or 5
-  segments: the motion is chaotic). At 20 Hz it rocks to 29 deg and goes backward
-  (-0.06 m/s); at 40, 65 and 80 Hz it rolls over (at 65 Hz the body jumps to 81 mm), at
-  100 Hz it rolls past 50 deg: no speed at 65 Hz to set beside the paper's 0.5 m/s.
-  Transmission damping is not the cause alone: zeta 0.15 or 0.3 still rolls over at 65 Hz.
-- Reduced amplitude: at 30 V (feet 1.0 mm quasi-static) the trot is upright at 5-65 Hz;
-  20 Hz: 0.096 m/s, the no-slip estimate within 2 % (tested), roll and pitch below 3 deg;
-  65 Hz: 0.185 m/s (0.37 x the paper), a bounding gait (the body 3-6 mm above its standing
-  height, the feet striking the ground briefly: 1 % of the samples). At 20 V the speed rises with frequency to 0.136 m/s at 40 Hz
-  (no-slip estimate within 1 %), then falls: 0.076 m/s at 65 Hz, backward at 80 Hz
-  (-0.30 m/s), where the lift (80 Hz) lags its drive by 90 deg and the swing (100 Hz) by
-  12 deg, so the feet touch down while swinging forward; the paper's phase loop exists
-  for this.
-- Measured before the fix of hamr_leg.add_leg's swing-stage centre of mass (commit
-  41b82c0: the robot's swing joints had carried twice the design inertia); the roll-over at
-  65 Hz is re-measured after it in mjeap.robots.hamr_walk_study: at full drive the 65 Hz
-  trot still rolls over, whatever single model parameter is changed; the lift amplitude
-  decides it (full swing with a 20 V lift: upright, 0.256 m/s; 30 V: 0.186 m/s; 40 V and
-  up: thrown off its feet), the lift transmission amplifying 2.9x at 65 Hz. Speed-frequency
-  (full swing, lift 20 V): 5, 10, 20, 40, 65 Hz: 0.067, 0.146, 0.282, 0.251, 0.256 m/s
-  (no-slip estimate 0.063, 0.135, 0.311, 0.392, 0.963), 80 and 100 Hz roll over.
-- The contact-force plot's spikes (18 N on FL's leg at t = 0.735 s in the 10 Hz run, 1300x
-  the weight): a foot striking the ground at 0.59 m/s (the body rocking onto it), stopped
-  within the contact's time constant (2 timesteps, 21 us): F ~ m_eff v / tau. The units are
-  right (mj_contactForce in mg mm / ms^2 = 1 mN); the peak is set by the numerical time
-  constant, not a physical stiffness, and the plot samples the instantaneous force every
-  2 ms, so it shows such a 20 us impact only when a sample falls in it.
+  and 2.9). After the fix:
+
+      f (Hz)   upright   speed (m/s)   no-slip est.   max |roll|, |pitch| (deg)   sliding
+        5       yes        0.081          0.069             7,  8                  75 %
+       10       yes        0.084          0.086            13, 11                  84 %
+       20       no         0.051          0.078            33, 13                  86 %
+       40       yes        0.156          0.232            24, 15                  89 %
+       65       no        (-0.13)         --               72, 61 (rolled over; body to 39 mm)
+     80, 100    no          --            --              180, 86 (on its back)
+
+  It trots upright at 5-10 Hz (the body rocking on its diagonal support and hopping on its
+  legs' lift compliance: k_foot = m_foot (2 pi 80 Hz)^2 = 9 N/m, the body bounces at 18 Hz
+  on two feet, 25 Hz on four, damped to zeta ~0.01) and, just, at 40 Hz; at 20 Hz it rocks
+  past UPRIGHT_DEG (33 deg) while still moving forward; from 65 Hz up it rolls over: no
+  speed at 65 Hz to set beside the paper's 0.5 m/s (mjeap.robots.hamr_walk_study: whatever
+  single model parameter is changed; the lift amplitude decides it: full swing with a 20 V
+  lift upright, 0.256 m/s; 30 V: 0.186 m/s; 40 V and up: thrown off its feet, the lift
+  transmission amplifying 2.9x at 65 Hz. Speed-frequency with full swing, lift 20 V: 5, 10,
+  20, 40, 65 Hz: 0.067, 0.146, 0.282, 0.251, 0.256 m/s, no-slip estimate 0.063, 0.135,
+  0.311, 0.392, 0.963; 80 and 100 Hz roll over). Before the fix: transmission damping
+  zeta 0.15 or 0.3 still rolled over at 65 Hz (not re-measured).
+- Reduced amplitude, after the fix: at 30 V (feet 1.0 mm quasi-static) 20 Hz: 0.093 m/s,
+  no-slip estimate 0.086 (9 % below; tested within 10 %), roll and pitch below 3 deg, 36 %
+  of the stance samples sliding; 65 Hz: 0.217 m/s (0.43 x the paper; no-slip estimate
+  0.331), roll and pitch 7 and 5 deg, a bounding gait (the body 13.4-15.6 mm high against
+  11.6-12.0 mm at 20 Hz). At 20 V the speed rises with frequency and stays upright: 20, 40,
+  65, 80 Hz: 0.053, 0.099, 0.232, 0.291 m/s (no-slip estimate 0.047, 0.100, 0.301, 0.331).
+  Before the fix the 20 V trot walked backward at 80 Hz (-0.30 m/s: the swing, at 71 Hz,
+  lagged past the lift); after it, it does not (see Closed loop).
+- The contact-force plot's spikes (measured before the fix: 18 N on FL's leg at t = 0.735 s
+  in the 10 Hz run, 1300x the weight): a foot striking the ground at 0.59 m/s (the body
+  rocking onto it), stopped within the contact's time constant (2 timesteps, 21 us): F ~
+  m_eff v / tau. The units are right (mj_contactForce in mg mm / ms^2 = 1 mN); the peak is
+  set by the numerical time constant, not a physical stiffness, and the plot samples the
+  instantaneous force every 2 ms, so it shows such a 20 us impact only when a sample falls
+  in it.
 - Closed loop (:func:`walk_closed_loop`: the single leg's phase loops on all eight
   actuators, each reading only its own drive current through the estimator calibrated on
   the free actuator at 200 V and 4 segments; gains from phase_loop_gains at the trot
   frequency; the transmissions' sweep on the 4-segment leg at 200 V fits 99.8 Hz and 79.8
-  Hz, zeta 0.052, the model's 100 / 80 Hz, 0.05): at 20 V, 80 Hz, open loop the feet lag
-  63-143 deg and the robot walks backward (-0.48 m/s over cycles 24-39); closed after 6
-  cycles it walks forward (+0.15 m/s), each foot's error averages within 8 deg, but
-  scatters 10-60 deg rms from cycle to cycle (the stance impacts and the body's bounce move
-  the foot relative to the body): no foot holds 5 deg.
-- Incline (the ground tilted, gravity along -z): full amplitude at 10 Hz climbs 4 deg, not
-  8; 30 V at 20 Hz climbs 8, not 12 (the paper: nearly 22 deg).
+  Hz, zeta 0.052, the model's 100 / 80 Hz, 0.05), at 20 V, 80 Hz (the lifts' resonance,
+  where their open-loop lag is largest: the second-order model's 90 deg, the swings' 12.5),
+  after the fix, 40 cycles closed after 6: open loop (cycles 4-39) the lifts lag 70.5-75.6
+  deg (less than 90: stance adds the ground's stiffness to the lift) and the swings
+  15.3-21.3 deg, each with a per-cycle scatter of 8-15 deg sd; closed, each foot's true
+  error over cycles 16-39 averages -0.9..+4.4 deg (standard error of that mean 1.6-3.2
+  deg), but scatters 8-15 deg sd from cycle to cycle (the stance impacts and the body's
+  bounce move the foot relative to the body): no foot holds 5 deg every cycle (four come
+  within it only over the last cycles). The sensed
+  error follows the true one on average within 2.6 deg. The open loop walks forward here
+  (+0.35 m/s over the last 16 cycles, upright), faster than the closed loop (+0.30 m/s,
+  upright): the loops correct the feet's phase, not the speed. Before the fix the open loop
+  walked backward (-0.48 m/s) and the loop turned it forward; after it no drive near the
+  lift resonance shows that: at 85 and 90 Hz (lifts lagging 102-110 and 118-128 deg) the
+  open loop walks forward too (+0.30, +0.55 m/s), and the closed loop leaves the lifts' mean
+  error at 5-10 and 13-33 deg. 80 Hz stays the demonstration: the largest lift lag whose
+  loop settles.
+- Incline (the ground tilted, gravity along -z), after the fix: full amplitude at 10 Hz
+  climbs 8 deg (0.005 m/s), not 12 (-0.13 m/s); 30 V at 20 Hz climbs 8 deg (0.066 m/s), not
+  12 (-0.063 m/s) (the paper: nearly 22 deg).
 """
 from __future__ import annotations
 
@@ -388,7 +411,7 @@ def walk_metrics(run: dict) -> dict:
 
 
 # ---- closed loop: the single leg's two phase loops on all eight actuators (issue 25) ----
-LOOP_FREQUENCY, LOOP_AMPLITUDE = 80.0, 20.0     # Hz, V: open loop the robot walks backward here (the lift lags)
+LOOP_FREQUENCY, LOOP_AMPLITUDE = 80.0, 20.0     # Hz, V: the lifts' resonance: open loop they lag most (~70-75 deg)
 OPEN_LOOP_CYCLES = RAMP_CYCLES + 4              # cycles before the loops close (the soft start, then 4)
 LOOP_CYCLES = 40                                # cycles of a closed-loop walk, the open-loop ones included
 LOOP_MEASURE_CYCLES = 16                        # the walk metrics of a closed-loop walk: its last cycles
