@@ -602,7 +602,7 @@ class System:
     @guarded("rrd")
     def rollout(self, voltages, duration: float, initial_curvatures: Union[float, Sequence[float]] = 0.0,
                 sample_interval: Optional[float] = None, rrd: Union[str, Path, None] = None,
-                on_sample=None, controller=None, engine: str = "auto") -> SystemResult:
+                on_sample=None, controller=None, engine: str = "auto", estimate_error: bool = False) -> SystemResult:
         """Run for ``duration`` s with one voltage per actuator (waveform text,
         :class:`~mjeap.Waveform`, callable v(t) or None for its rest voltage; a list or a dict
         by prefix). Returns a :class:`SystemResult`; with ``rrd`` a Rerun recording (written
@@ -613,11 +613,18 @@ class System:
         hold over it, one per actuator or a dict by prefix (None: unchanged); each is checked
         against its drive's safe range. It may read the system's state; a controller that
         senses an actuator's current steps a :meth:`drive_observer` with them. ``engine``: one
-        that runs systems (:func:`mjeap.engines.choose_system`; 'auto': the loop engine)."""
+        that runs systems (:func:`mjeap.engines.choose_system`; 'auto': the loop engine).
+        ``estimate_error``: each actuator's tip-curvature error from the timestep, against the
+        system at half the step (:func:`mjeap.simulation.accuracy.estimate_system_error`; 2 x
+        the cost; open loop without ``on_sample``), in ``meta['accuracy']``."""
         from ..engines import choose_system
         from ..engines.frame import Samples, check_work, sample_steps as steps_of, to_waveform, voltage_steps
         from ..io.outputs import write_outputs
         duration = check_positive("duration", duration, "s")
+        if estimate_error and (controller is not None or on_sample is not None):
+            raise ParameterError("estimate_error", estimate_error, "False with a controller or on_sample: the "
+                                 "companion run at half the step would call them again (they may keep state or "
+                                 "move the model)")
         eng, engine_reason = choose_system(engine, self, controller, on_sample)
         if controller is not None:
             if voltages is not None and any(v is not None for v in self._per_actuator("voltages", voltages)):
@@ -708,7 +715,17 @@ class System:
             names = [mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b) or f"body{b}" for b in range(nb)]
             res = SystemResult(samples[0].t[:n] if samples else np.zeros(0), results, names, pos[:n], quat[:n],
                                fc[:n], meta)
+            if estimate_error and error is None:
+                from .accuracy import estimate_system_error
+                estimate_system_error(self, res, lambda comp, interval: comp.rollout(
+                    voltages, duration, initial_curvatures, sample_interval=interval, engine=engine))
             if rrd is not None:
                 from ..io.recording import write_system_recording
                 write_outputs([(rrd, lambda: write_system_recording(rrd, res, self))], error, res)
         return res
+
+    def half_step(self) -> "System":
+        """This system at half its timestep: a copy of its spec with the same actuators,
+        integrator and contact parameters (contact's time constant, in steps, halves with it)."""
+        return System(self.spec.copy(), self.actuators, self.units, timestep=self.timestep / 2,
+                      integrator=self.integrator, contact=self.contact)
