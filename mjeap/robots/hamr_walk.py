@@ -162,6 +162,9 @@ BIAS = 200.0                    # V, HAMR's drive bias (the brief's "paper's 200
 AMPLITUDE = 0.5 * BIAS          # V, full amplitude: the signal swings 0..V_bias
 SEGMENTS = 4
 PAPER_SPEED, PAPER_FREQUENCY = 0.5, 65.0      # m/s at Hz, seed 003
+#: V: a lift amplitude at which the full-swing 65 Hz trot stays upright (hamr_walk_study: 20 and
+#: 30 V upright, 40 V and full roll over), run beside the full drive where that rolls over
+LIMITED_LIFT = 20.0
 PAPER_INCLINE = 22.0                          # deg, seed 003 ("inclines nearing 22 deg")
 FREQUENCIES = (5.0, 10.0, 20.0, 40.0, 65.0, 80.0, 100.0)
 FREQUENCY_RANGE = (1.0, 100.0)                # Hz
@@ -777,6 +780,14 @@ def main(argv=None):
         out["speed_at_65hz_m_s"], out["paper_speed_m_s"], out["upright_at_65hz"] = v, PAPER_SPEED, up
         # a robot that rolled over has no speed to compare
         out["speed_over_paper"] = v / PAPER_SPEED if up else None
+        if not up:      # the cause, shown: the same swing with the lift at LIMITED_LIFT (hamr_walk_study)
+            m = walk_metrics(walk(system, PAPER_FREQUENCY, a.amplitude, lift_amplitude=LIMITED_LIFT))
+            out["at_65hz_lift_limited"] = {
+                "lift_amplitude_v": LIMITED_LIFT, "speed_m_s": m["speed_m_s"], "upright": upright(m),
+                "speed_over_paper": m["speed_m_s"] / PAPER_SPEED if upright(m) else None,
+                "max_abs_roll_deg": m["max_abs_roll_deg"], "max_abs_pitch_deg": m["max_abs_pitch_deg"],
+                "cause": "at 65 Hz the lift transmission (80 Hz) amplifies its drive ~2.9 x: the feet throw the "
+                         "body off the ground at full lift (mjeap.robots.hamr_walk_study)"}
     low = at[min(at)]
     k = low["kinematic_speed_m_s"]
     out["kinematic_check"] = {"frequency_hz": low["frequency_hz"], "speed_m_s": low["speed_m_s"],
