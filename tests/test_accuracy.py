@@ -180,3 +180,20 @@ def test_a_bad_error_model_is_refused_naming_it(bad):
 def test_an_error_model_without_a_target_is_refused():
     with pytest.raises(ParameterError, match="error_model"):
         rollout(Scene("pedot-micro", **FAST), "step:1V", 0.01, error_model=(0.1, 1.0))
+
+
+def test_the_claim_with_shared_priors_on_seeded_cases():
+    """The first 6 of the seeded claim's cases (seed 23), each also run from priors 4 x off
+    its own pilots' constants either way, (4 a, b / 4) and (a / 4, 4 b), as a sweep's family
+    shares them: the true error below the target in every run and the estimate never 3 x too
+    low. Measured on all 11 cases: true error at most 0.55 x the target; estimate 0.82 to
+    4.6 x (4 a, b / 4) and 0.82 to 5.5 x (a / 4, 4 b) the true error, within 3 x in 9 and 10
+    of 11: the shared path errs high, over-resolving, where its priors are pessimistic."""
+    rows = []
+    for case in draw_cases(seed=23, n=6):
+        a, b = check_case(case)["error_model"]
+        rows += [check_case(case, error_model=p) for p in ((4 * a, b / 4), (a / 4, 4 * b))]
+    s = summarise(rows)
+    detail = "\n".join(f"{r['case']}: true {r['true_error']:.3g}, estimate {r['estimated_error']:.3g}" for r in rows)
+    assert s["below_target"] == 1.0, detail
+    assert s["estimate_over_true_range"][0] >= 1 / 3, detail
