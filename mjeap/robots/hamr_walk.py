@@ -611,22 +611,26 @@ def segment_effect(segments: Sequence[int] = (2, SEGMENTS, 20), frequencies: Seq
 
 
 def max_incline(frequency: float = RECORD_FREQUENCY, amplitude: float = AMPLITUDE, mu: float = MU,
-                segments: int = SEGMENTS, step: float = 4.0, top: float = 32.0) -> dict:
+                segments: int = SEGMENTS, step: float = 4.0, top: float = 32.0,
+                lift_amplitude: Optional[float] = None) -> dict:
     """The steepest ground incline (deg, in ``step`` up to ``top``) on which the trot at
-    ``frequency`` still climbs: forward speed along the slope > 0 with the body upright
-    (|roll| and |pitch| below UPRIGHT_DEG) over the measuring window. The ground is tilted,
-    gravity stays along -z (attach sizes the actuators for it)."""
+    ``frequency`` (the lifts at ``lift_amplitude``, default ``amplitude``) still climbs:
+    forward speed along the slope > 0 with the body upright (|roll| and |pitch| below
+    UPRIGHT_DEG) over the measuring window. The ground is tilted, gravity stays along -z
+    (attach sizes the actuators for it)."""
     d = design()
     tried, best = [], None
     for angle in np.arange(0.0, top + 1e-9, step):
-        m = walk_metrics(walk(build(mu, segments, incline_deg=float(angle), d=d), frequency, amplitude))
+        m = walk_metrics(walk(build(mu, segments, incline_deg=float(angle), d=d), frequency, amplitude,
+                              lift_amplitude=lift_amplitude))
         ok = m["speed_m_s"] > 0 and upright(m)
         tried.append({"incline_deg": float(angle), "speed_m_s": m["speed_m_s"], "upright": upright(m)})
         if not ok:
             break
         best = float(angle)
-    return {"frequency_hz": frequency, "max_incline_deg": best, "step_deg": step, "tried": tried,
-            "paper_incline_deg": PAPER_INCLINE}
+    return {"frequency_hz": frequency, "amplitude_v": amplitude,
+            "lift_amplitude_v": amplitude if lift_amplitude is None else lift_amplitude, "max_incline_deg": best,
+            "step_deg": step, "tried": tried, "paper_incline_deg": PAPER_INCLINE}
 
 
 def upright(metrics: dict) -> bool:

@@ -33,6 +33,16 @@ fix of hamr_leg.add_leg's stage centre of mass, commit 41b82c0):
   phase loop, seed 003, and a loaded leg's damping would both change it); the defaults are
   kept, and the 65 Hz speed within a factor of 2 of the paper's 0.5 m/s is reached only
   with the lift at 20-30 V (0.19-0.49 m/s).
+
+:func:`incline_study`: the steepest incline climbed (hamr_walk.max_incline, 4 deg steps)
+against the feet's friction. Measured (MuJoCo 3.17, full drive at 10 Hz, where it trots
+upright on level ground): mu 0.51: 8 deg; 0.8: 12 deg; 1.2: 16 deg (failing at the next
+step each time, still upright: it slides back). Far below the static friction angle
+(atan mu = 27, 39, 50 deg): the trot's feet slide through most of their stance (slip
+fraction 0.5-0.9 on level ground), so the climb is set by sliding friction during the
+stride, and it grows with mu. At 65 Hz with the lift at 20 V it climbs 8 deg at mu 0.51 and
+rolls over at mu 1.2. The paper's ~22 deg is not reached with these friction values; the
+surface of its incline tests is not in the sources here.
 """
 from __future__ import annotations
 
@@ -92,3 +102,12 @@ def frequency_sweep(frequencies: Sequence[float] = hw.FREQUENCIES, build: Option
         rows.append({k: m[k] for k in ("frequency_hz", "upright", "speed_m_s", "kinematic_speed_m_s",
                                        "max_abs_roll_deg", "max_abs_pitch_deg")})
     return rows
+
+
+def incline_study(mus: Sequence[float] = (hw.MU, 0.8, 1.2), frequency: float = hw.RECORD_FREQUENCY,
+                  **kw) -> list:
+    """The steepest incline climbed (hamr_walk.max_incline, options ``kw``) for each foot
+    friction coefficient in ``mus``, at ``frequency``."""
+    if not len(mus):
+        raise ParameterError("mus", mus, "at least one friction coefficient")
+    return [{"mu": float(mu), **hw.max_incline(frequency, mu=float(mu), **kw)} for mu in mus]
