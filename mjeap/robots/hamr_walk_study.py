@@ -35,9 +35,9 @@ fix of hamr_leg.add_leg's stage centre of mass, commit 41b82c0):
   with the lift at 20-30 V (0.19-0.49 m/s).
 
 :func:`incline_study`: the steepest incline climbed (hamr_walk.max_incline, 4 deg steps)
-against the feet's friction. Measured (MuJoCo 3.17, full drive at 10 Hz, where it trots
-upright on level ground): mu 0.51: 8 deg; 0.8: 12 deg; 1.2: 16 deg (failing at the next
-step each time, still upright: it slides back). Far below the static friction angle
+against the feet's friction. Measured (full drive at 10 Hz, where it trots upright on
+level ground): mu 0.51: 8 deg (MuJoCo 4.0; 4 on 3.17: the trot is chaotic); 0.8: 12 deg;
+1.2: 16 deg (3.17; failing at the next step each time, still upright: it slides back). Far below the static friction angle
 (atan mu = 27, 39, 50 deg): the trot's feet slide through most of their stance (slip
 fraction 0.5-0.9 on level ground), so the climb is set by sliding friction during the
 stride, and it grows with mu. At 65 Hz with the lift at 20 V it climbs 8 deg at mu 0.51 and
