@@ -239,7 +239,7 @@ class LegControllers:
     def __call__(self, t: float, system: System) -> dict:
         out = {}
         for nm, c in self.ctrls.items():
-            out[nm] = c(t, system)             # reads the current after the last step
+            out[nm] = c(t, None)               # reads the current after the last step, nothing of the system
             self.obs[nm].step(out[nm], self.dt)
         return out
 

@@ -367,7 +367,8 @@ def walk(system: System, frequency: float, amplitude: float = AMPLITUDE, settle:
 
 
 def walk_metrics(run: dict) -> dict:
-    """The read-outs of a :func:`walk` over its measuring window (see the module text)."""
+    """The read-outs of a :func:`walk` over its measuring window (see the module text), with
+    ``upright`` (:func:`upright`)."""
     t, f, G = run["time"], run["frequency"], run["ground"]
     k = t >= run["t0"] - 1e-12
     tw = t[k]
@@ -393,7 +394,7 @@ def walk_metrics(run: dict) -> dict:
     v_t = np.linalg.norm(vf - (vf @ up)[..., None] * up, axis=-1)
     threshold = max(SLIDE_FRACTION * stance_speed, 1e-4)
     slides = (v_t > threshold) & c
-    return {
+    out = {
         "frequency_hz": f, "amplitude_v": run["amplitude"], "lift_amplitude_v": run.get("lift_amplitude"),
         "speed_m_s": speed, "lateral_drift_m_s": lateral,
         "kinematic_speed_m_s": float(np.nanmean(v_est)) if any_c.any() else None,    # None: no foot ever down
@@ -410,6 +411,8 @@ def walk_metrics(run: dict) -> dict:
         "wall_time_s": float(run["result"].meta["wall_time_s"]),
         "wall_s_per_simulated_s": float(run["result"].meta["wall_time_s"] / t[-1]),
     }
+    out["upright"] = upright(out)
+    return out
 
 
 
@@ -453,14 +456,15 @@ def walk_loop_gains(frequency: float) -> dict:
     return {dof: phase_loop_gains(hamr_leg.ZETA, tr.resonance, frequency) for dof, tr in hamr_leg.DOFS.items()}
 
 
-class TrotPhaseControllers:
+class TrotPhaseControllers(hamr_leg.LegControllers):
     """The eight phase loops as one system controller: per actuator a
     controllers.hamr_leg.LegPhaseController (the single leg's) driving V_bias/2 + a sin(omega t
     + phi), phi starting at the trot's phase (:func:`desired_phases`), the amplitude ramped
     over RAMP_CYCLES as the open-loop trot's; after ``open_loop_cycles`` phi moves once per
     cycle by the PI on the sensed foot phase error. Each loop reads only its own actuator's
     drive current (a drive observer stepped with the voltage it holds) through its own copy
-    of ``estimator`` (:func:`walker_estimator` if None); nothing else of the simulator."""
+    of ``estimator`` (:func:`walker_estimator` if None); nothing else of the simulator. Stepped
+    as the single leg's (hamr_leg.LegControllers.__call__)."""
 
     name = "eight foot phase PIs on the self-sensed currents"
 
@@ -482,13 +486,6 @@ class TrotPhaseControllers:
             self.obs[prefix] = system.drive_observer(prefix)
             c.reset(system, self.obs[prefix])
             self.ctrls[prefix] = c
-
-    def __call__(self, t: float, system: System) -> dict:
-        out = {}
-        for prefix, c in self.ctrls.items():
-            out[prefix] = c(t, None)            # reads the current after the last step, nothing of the system
-            self.obs[prefix].step(out[prefix], self.dt)
-        return out
 
 
 def foot_phase_errors(run: dict, cycles: int) -> dict:
@@ -552,16 +549,13 @@ def loop_summary(run: dict, open_run: Optional[dict] = None, tol_deg: float = PH
                   "gains_kp_ki_kd": e["gains"],
                   "true_deg": [float(x) for x in e["true_deg"]], "sensed_deg": [float(x) for x in e["sensed_deg"]]}
     m = walk_metrics(run)
-    m["upright"] = upright(m)
     out = {"frequency_hz": run["frequency"], "amplitude_v": run["amplitude"], "open_loop_cycles": n_open,
            "cycles": len(next(iter(run["errors"].values()))["true_deg"]) + 1, "tolerance_deg": tol_deg,
            "actuators": act, "closed_loop": m,
            "max_cycles_to_tol": None if any(a["cycles_to_tol"] is None for a in act.values())
            else max(a["cycles_to_tol"] for a in act.values())}
     if open_run is not None:
-        mo = walk_metrics(open_run)
-        mo["upright"] = upright(mo)
-        out["open_loop"] = mo
+        out["open_loop"] = walk_metrics(open_run)
     return out
 
 
@@ -623,8 +617,8 @@ def max_incline(frequency: float = RECORD_FREQUENCY, amplitude: float = AMPLITUD
     for angle in np.arange(0.0, top + 1e-9, step):
         m = walk_metrics(walk(build(mu, segments, incline_deg=float(angle), d=d), frequency, amplitude,
                               lift_amplitude=lift_amplitude))
-        ok = m["speed_m_s"] > 0 and upright(m)
-        tried.append({"incline_deg": float(angle), "speed_m_s": m["speed_m_s"], "upright": upright(m)})
+        ok = m["speed_m_s"] > 0 and m["upright"]
+        tried.append({"incline_deg": float(angle), "speed_m_s": m["speed_m_s"], "upright": m["upright"]})
         if not ok:
             break
         best = float(angle)
@@ -771,7 +765,6 @@ def main(argv=None):
     for f in freqs:
         run = walk(system, f, a.amplitude)
         m = walk_metrics(run)
-        m["upright"] = upright(m)
         out["runs"].append(m)
         if f == a.record_frequency and a.out:
             write_recording(a.out, system, run)
@@ -787,8 +780,8 @@ def main(argv=None):
         if not up:      # the cause, shown: the same swing with the lift at LIMITED_LIFT (hamr_walk_study)
             m = walk_metrics(walk(system, PAPER_FREQUENCY, a.amplitude, lift_amplitude=LIMITED_LIFT))
             out["at_65hz_lift_limited"] = {
-                "lift_amplitude_v": LIMITED_LIFT, "speed_m_s": m["speed_m_s"], "upright": upright(m),
-                "speed_over_paper": m["speed_m_s"] / PAPER_SPEED if upright(m) else None,
+                "lift_amplitude_v": LIMITED_LIFT, "speed_m_s": m["speed_m_s"], "upright": m["upright"],
+                "speed_over_paper": m["speed_m_s"] / PAPER_SPEED if m["upright"] else None,
                 "max_abs_roll_deg": m["max_abs_roll_deg"], "max_abs_pitch_deg": m["max_abs_pitch_deg"],
                 "cause": "at 65 Hz the lift transmission (80 Hz) amplifies its drive ~2.9 x: the feet throw the "
                          "body off the ground at full lift (mjeap.robots.hamr_walk_study)"}

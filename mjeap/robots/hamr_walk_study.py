@@ -70,10 +70,8 @@ VARIANTS = (
 def study_run(frequency: float = hw.PAPER_FREQUENCY, build: Optional[dict] = None, walk: Optional[dict] = None,
               d: Optional[dict] = None, **walk_kw) -> dict:
     """One trot: hamr_walk.build(**build) walked at ``frequency`` (walk options ``walk``);
-    the walk_metrics with 'upright' added."""
-    m = hw.walk_metrics(hw.walk(hw.build(d=d, **(build or {})), frequency, **(walk or {}), **walk_kw))
-    m["upright"] = hw.upright(m)
-    return m
+    its walk_metrics."""
+    return hw.walk_metrics(hw.walk(hw.build(d=d, **(build or {})), frequency, **(walk or {}), **walk_kw))
 
 
 def rolling_study(variants: Sequence = VARIANTS, frequency: float = hw.PAPER_FREQUENCY) -> list:

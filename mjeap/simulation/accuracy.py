@@ -76,7 +76,7 @@ from ..errors import ParameterError
 
 __all__ = ["QUANTITY", "ACCURACY_RANGE", "Model", "ErrorModel", "check_accuracy", "target_for", "relative_difference",
            "calibrate", "choose_model", "run_at_accuracy", "estimate_error", "as_error_model", "fewer_segments",
-           "spatial_error", "estimate_system_error"]
+           "spatial_error", "half_step_error", "estimate_system_error"]
 
 QUANTITY = ("tip curvature: max over the samples of |kappa - kappa_converged| / swing, the swing being the "
             "peak-to-peak tip curvature of the run")
@@ -285,12 +285,12 @@ def _estimate(fine, mid, coarse, spatial) -> List[tuple]:
     measured by a companion of fewer segments): per member the pair (step, segments)."""
     out = []
     members = _each(fine)
-    spatial = list(spatial) if isinstance(spatial, (list, tuple)) else [spatial] * len(members)
-    for f, m, c, spatial in zip(members, _each(mid), _each(coarse), spatial):
+    e_s = list(spatial) if isinstance(spatial, (list, tuple)) else [spatial] * len(members)
+    for f, m, c, e in zip(members, _each(mid), _each(coarse), e_s):
         d1 = relative_difference(f, m)
         d2 = relative_difference(m, c) * float(np.ptp(m.tip_curvature)) / max(float(np.ptp(f.tip_curvature)), 1e-300)
         r = min(max(d2 / d1, RATIO_RANGE[0]), RATIO_RANGE[1]) if d1 > 0 else RATIO_RANGE[1]
-        out.append((d1 / (r - 1), spatial))
+        out.append((d1 / (r - 1), e))
     return out
 
 
@@ -374,10 +374,10 @@ def run_at_accuracy(scene, run, *, accuracy: float, duration: float, wave=None,
         try:
             _check_work(model, duration, target, em, "given")
         except ParameterError:      # a prior too pessimistic for this question: its own pilots decide
-            given, measure = None, False
-            em = calibrate(runner, h_pilot)
+            measure, em = False, calibrate(runner, h_pilot)
             model = choose_model(scene, em, target, duration, grid, h_cap)
-    _check_work(model, duration, target, em, "given" if measure else "pilots of this question")
+    if not measure:
+        _check_work(model, duration, target, em, "pilots of this question")
     chosen, model, result, parts = _run_with_companions(runner, model, "chosen", em.spatial, measure)
     estimates = _combined(parts)
     refinements = 0
@@ -424,6 +424,13 @@ def run_at_accuracy(scene, run, *, accuracy: float, duration: float, wave=None,
 ASSUMED_ORDER = 1.5
 
 
+def half_step_error(result, finer) -> float:
+    """The step's error of ``result`` from one companion at half its step: d 2^p / (2^p - 1),
+    d = max |kappa_h - kappa_h/2| over the swing, p = ASSUMED_ORDER."""
+    g = 2 ** ASSUMED_ORDER
+    return relative_difference(result, finer) * g / (g - 1)
+
+
 def estimate_error(scene, run, result, *, duration: float, sample_interval: Optional[float]) -> dict:
     """The error of ``result``, a run of ``scene`` as built (no target), estimated as
     :func:`run_at_accuracy` does: the step's by companions at 2 h and 4 h, the segments' by
@@ -445,8 +452,7 @@ def estimate_error(scene, run, result, *, duration: float, sample_interval: Opti
             for c in comps + [Model(n_s, model.timestep, model.integrator)]]
     spatial = spatial_error(result, runs.pop(), model.segments, n_s)
     if finer:
-        g = 2 ** ASSUMED_ORDER
-        e = math.hypot(relative_difference(result, runs[0]) * g / (g - 1), spatial)
+        e = math.hypot(half_step_error(result, runs[0]), spatial)
         how = (f"step: against {comps[0].describe()} (order {ASSUMED_ORDER} assumed: implicitfast's stability "
                "limit keeps it from 2 h)")
     else:
@@ -463,8 +469,7 @@ def estimate_system_error(system, result, run) -> dict:
     """Each actuator's tip-curvature error in ``result``, a run of ``system`` (a
     :class:`~mjeap.simulation.system.System`), from its timestep: ``run(companion,
     interval)`` runs :meth:`System.half_step` sampled every ``interval`` s, and the error is
-    d 2^p / (2^p - 1), d = max |kappa_h - kappa_h/2| over the swing, p = ASSUMED_ORDER (as
-    :func:`estimate_error` under 'implicitfast'). The segments' error is not estimated: a
+    :func:`half_step_error` (as :func:`estimate_error` under 'implicitfast'). The segments' error is not estimated: a
     System does not rebuild its actuators (build it with other ``segments=`` to compare).
     Where contact is on, its time constant (2 steps) halves with the step, so the estimate
     includes how much the contact model's own stiffness moves the result. Writes each
@@ -473,12 +478,11 @@ def estimate_system_error(system, result, run) -> dict:
     interval = float(t[1] - t[0]) if len(t) > 1 else None
     companion = system.half_step()
     other = run(companion, interval)
-    g = 2 ** ASSUMED_ORDER
     out = {}
     for a in system.actuators:
         name = a.prefix.rstrip("/")
-        r, o = result.actuators[name], other.actuators[name]
-        e = relative_difference(r, o) * g / (g - 1)
+        r = result.actuators[name]
+        e = half_step_error(r, other.actuators[name])
         rep = {"quantity": QUANTITY, "target": None,
                "model": asdict(Model(a.twin.layout.segments, system.timestep, system.integrator)),
                "estimated_error": e,

@@ -74,9 +74,7 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     drv = drive if (drive is not None and not isinstance(drive, str)) else \
         make_drive(drive, scene, **(drive_params or {}))
     target = target_for(scene, accuracy)
-    if error_model is not None:
-        from .accuracy import as_error_model
-        as_error_model(error_model)
+    if error_model is not None:         # its values are checked by run_at_accuracy, before any run
         if target is None:
             raise ParameterError("error_model", error_model, "None without an accuracy target (it chooses the model "
                                  "for one)")
