@@ -343,22 +343,25 @@ def _with_shared_error_models(executor: str, workers: int, scheduler: Optional[s
     question but for LOAD_SIZE) runs first with its own pilots; the family's other points
     start from its error model (a, b) instead of pilots of their own, their error still
     measured on each (:func:`mjeap.simulation.accuracy.run_at_accuracy`). Points of a
-    family whose first point failed run their own pilots."""
-    leads, rest, seen = [], [], set()
+    family whose first point failed run their own pilots. Points without a target run
+    beside the first points."""
+    first, rest, seen, lead_family = [], [], set(), {}     # lead_family: a first point's id -> its family
     for job in jobs:
         key = _family(job)
-        if key is not None and key not in seen:
-            seen.add(key)
-            leads.append(job)
-        else:
+        if key is not None and key in seen:
             rest.append((key, job))
-    if not leads:
+            continue
+        if key is not None:
+            seen.add(key)
+            lead_family[point_id(job[0], job[2], job[1])] = key
+        first.append(job)
+    if not lead_family:
         yield from _submit_all(executor, workers, scheduler, jobs)
         return
-    lead_family = {point_id(j[0], j[2], j[1]): _family(j) for j in leads}
     models = {}
-    for row in _submit_all(executor, workers, scheduler, leads):
-        models[lead_family[row["point_id"]]] = row.get("_error_model")
+    for row in _submit_all(executor, workers, scheduler, first):
+        if row["point_id"] in lead_family:
+            models[lead_family[row["point_id"]]] = row.get("_error_model")
         yield row
     yield from _submit_all(executor, workers, scheduler,
                            [tuple(job[:4]) + (models.get(key),) for key, job in rest])
