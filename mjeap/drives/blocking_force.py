@@ -15,6 +15,7 @@ import numpy as np
 from scipy import signal
 
 from ..errors import ParameterError
+from ..model import lti
 from .base import Drive, NativeForm, OpenLoop, ExactLTI, register_drive
 
 _EST = "estimate (seed 001 gives no extractable number; actuator reference: a few tenths of a mN to ~1 mN at 1 V)"
@@ -104,10 +105,10 @@ class BlockingForceDrive(OpenLoop, NativeForm, Drive):
                 "stiffness_factor (-)": float(self.part._stiffness_scale)}
 
     def reference_curvature(self, t, v, initial_curvature=0.0):
-        """Quasi-static: uniform curvature (2/3) F_B L / (f(V) EI), F_B by scipy lsim
-        of the same first-order response (beam inertia and damping neglected)."""
+        """Quasi-static: uniform curvature (2/3) F_B L / (f(V) EI), F_B the same first-order
+        response (:func:`mjeap.model.lti.lsim`; beam inertia and damping neglected)."""
         tau, F1 = self.params["time_constant"], self.params["blocking_force_per_volt"]
-        _, FB, _ = signal.lsim(signal.TransferFunction([F1], [tau, 1.0]), np.asarray(v, float), np.asarray(t, float))
+        FB = lti.lsim(signal.TransferFunction([F1], [tau, 1.0]), v, t)
         EI = float(self.scene.actuator.flexural_rigidity_at(0.0)[0])
         f = np.array([self.stiffness(x) for x in v])
         return 2.0 / 3.0 * FB * self.L / (f * EI)

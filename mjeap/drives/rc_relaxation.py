@@ -23,6 +23,7 @@ import mujoco
 import numpy as np
 from scipy import signal
 
+from ..model import lti
 from ..model.analytical import DadrasModel
 from ..errors import ParameterError
 from .base import Drive, NativeForm, register_drive, zoh_first_order
@@ -200,7 +201,7 @@ class RCRelaxationDrive(NativeForm, Drive):
                                        np.polymul([1.0, p["pole_mechanical"]], [1.0, p["pole_electrical"]]))
 
     def reference_curvature(self, t, v, initial_curvature=0.0):
-        """Eq. (8) by scipy.signal.lsim from rest, plus the initial curvature decaying on the
-        mechanical pole (the zero-input term of eq. 7). Unloaded beam."""
-        _, y, _ = signal.lsim(self.transfer_function(), np.asarray(v, dtype=float), np.asarray(t, dtype=float))
+        """Eq. (8) from rest (:func:`mjeap.model.lti.lsim`, as scipy.signal.lsim), plus the initial
+        curvature decaying on the mechanical pole (the zero-input term of eq. 7). Unloaded beam."""
+        y = lti.lsim(self.transfer_function(), v, t)
         return y + initial_curvature * np.exp(-self.params["pole_mechanical"] * (np.asarray(t) - t[0]))

@@ -16,6 +16,7 @@ import numpy as np
 from scipy import integrate, optimize, signal
 
 from ..errors import ParameterError, check_positive
+from . import lti
 from .section import SectionLayer, SectionProperties, multilayer_section  # noqa: F401  (re-export)
 
 __all__ = [
@@ -310,10 +311,10 @@ class DadrasModel:
 
     def free_curvature(self, t: np.ndarray, v: np.ndarray) -> np.ndarray:
         """Curvature (1/m) of the unloaded beam at the uniform sample times ``t`` (s) for the
-        voltage samples ``v`` (V, held between samples), from rest: eq. (8) by scipy lsim."""
+        voltage samples ``v`` (V, held between samples), from rest: eq. (8) (:func:`lti.lsim`, as scipy's)."""
         tf = signal.TransferFunction([self.k_tf, self.k_tf * self.zero],
                                      np.polymul([1.0, self.pole], [1.0, self.electrical_pole]))
-        return signal.lsim(tf, np.asarray(v, float), np.asarray(t, float), interp=False)[1]
+        return lti.lsim(tf, v, t, interp=False)
 
     def grip_force(self, t: np.ndarray, v: np.ndarray, a: float, gap: float) -> np.ndarray:
         """Contact force (N) of this actuator closing a gap ``gap`` (m) on a rigid stop at
@@ -331,7 +332,7 @@ class DadrasModel:
         EI = 1.0 / self.mechanical_gain
         excess = np.clip(self.free_curvature(t, v) * a**2 / 2 - gap, 0.0, None)
         tf = signal.TransferFunction([3 * EI / a**3, 3 * EI / a**3 * self.pole], [1.0, self.zero])
-        return signal.lsim(tf, excess, np.asarray(t, float), interp=True)[1]
+        return lti.lsim(tf, excess, t, interp=True)
 
     def response(self, t: np.ndarray, v: np.ndarray, mass: float = 0.0, l_e: float = 6e-3,
                  kappa0: float = 0.0) -> Tuple[np.ndarray, np.ndarray]:

@@ -151,11 +151,10 @@ class ErrorModel:
 
 def _shared(a, b):
     """Indices (i, j) of the instants a.time[i] == b.time[j] both runs sampled."""
-    ia = {round(t, 9): i for i, t in enumerate(np.round(a.time, 9))}
-    pairs = [(ia[round(t, 9)], j) for j, t in enumerate(np.round(b.time, 9)) if round(t, 9) in ia]
-    if not pairs:
+    _, i, j = np.intersect1d(np.round(a.time, 9), np.round(b.time, 9), return_indices=True)
+    if not len(i):
         raise ValueError("the two runs share no sample instant")
-    return np.array(pairs).T
+    return i, j
 
 
 def relative_difference(a, b) -> float:

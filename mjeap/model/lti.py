@@ -1,0 +1,40 @@
+"""Responses of linear time-invariant models on a uniform sample grid, from rest.
+
+:func:`lsim` gives what ``scipy.signal.lsim(system, u, t, interp=...)`` gives (zero initial
+state; the input linearly interpolated between samples, or held), computed by the same
+exact discretisation (``scipy.signal.cont2discrete``, first- or zero-order hold) but run
+by ``scipy.signal.lfilter`` in C instead of scipy's per-sample Python loop: a 5,000-sample
+response in ~1 ms instead of ~15-20 ms (every seed 000 rollout computes one; equal to
+scipy's to ~1e-11 of the swing, tests/test_lti.py). A grid that
+is not uniform goes to ``scipy.signal.lsim`` itself.
+"""
+from __future__ import annotations
+
+import numpy as np
+from scipy import signal
+
+__all__ = ["lsim"]
+
+
+def lsim(system: signal.TransferFunction, u, t, interp: bool = True) -> np.ndarray:
+    """Output of ``system`` (a continuous TransferFunction) at the times ``t`` (s, uniform)
+    for the input samples ``u``, from rest; ``interp``: input linear between samples
+    (True) or held (False), as scipy.signal.lsim."""
+    u, t = np.asarray(u, dtype=float), np.asarray(t, dtype=float)
+    if t.ndim != 1 or u.shape != t.shape:
+        raise ValueError("t and u must be 1-D arrays of the same length")
+    if len(t) < 3:
+        return signal.lsim(system, u, t, interp=interp)[1]
+    dt = (t[-1] - t[0]) / (len(t) - 1)
+    if not (dt > 0 and np.allclose(np.diff(t), dt, rtol=1e-9, atol=0.0)):
+        return signal.lsim(system, u, t, interp=interp)[1]
+    tf = (system.num, system.den)
+    num, den, _ = signal.cont2discrete(tf, dt, method="zoh")
+    if not interp:
+        return signal.lfilter(np.atleast_2d(num)[0], den, u)
+    # linear interpolation from rest: the first sample held (exact under zero-order hold)
+    # plus the interpolated rest, which starts at zero (so the first-order-hold state,
+    # x - B1 u, starts at zero too and lfilter's rest is the system's)
+    y = signal.lfilter(np.atleast_2d(num)[0], den, np.full_like(u, u[0]))
+    num, den, _ = signal.cont2discrete(tf, dt, method="foh")
+    return y + signal.lfilter(np.atleast_2d(num)[0], den, u - u[0])
