@@ -110,3 +110,19 @@ def test_divergence_stops_at_the_same_step_with_the_reason():
             rollout(s, "step:150V", 0.005, engine=engine)
         steps.append(int(re.search(r"by step (\d+)", str(err.value)).group(1)))
     assert steps[0] == steps[1]
+
+
+@pytest.mark.parametrize("engine", ["threaded", "native"])
+def test_pipelined_chunks_change_nothing(monkeypatch, engine):
+    """The pipeline (the next chunk rolls while this one's samples are taken) hands each
+    chunk's last state to the next: one chunk or many, with samples on chunk edges and off
+    them, the results are the same to the bit."""
+    s = Scene("ppy-trilayer")
+    waves, k0 = ["square:0.5V@0.5Hz", "sine:0.3V@1Hz"], [0.0, 20.0]
+    kw = dict(initial_curvatures=k0, nthread=2, engine=engine)
+    monkeypatch.setattr(threaded, "PIPELINE_CHUNKS", 1)
+    one = rollout_batch(s, waves, 2.0, **kw)
+    for chunks in (7, 64):
+        monkeypatch.setattr(threaded, "PIPELINE_CHUNKS", chunks)
+        for a, b in zip(one, rollout_batch(s, waves, 2.0, **kw)):
+            _assert_same(a, b, rtol=0.0)

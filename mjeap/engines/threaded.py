@@ -19,6 +19,7 @@ which replays the drive's own step), so they are the lockstep loop's read-outs e
 """
 from __future__ import annotations
 
+from concurrent.futures import ThreadPoolExecutor
 from typing import List, Optional, Sequence
 
 import mujoco
@@ -34,6 +35,8 @@ NATIVE_CONTROL = mujoco.mjtState.mjSTATE_CTRL
 LOADS = mujoco.mjtState.mjSTATE_XFRC_APPLIED
 #: the state and control arrays of one chunk stay below this size
 CHUNK_BYTES = 64 * 2**20
+#: a run goes in at least this many chunks (the pipeline of :func:`roll`)
+PIPELINE_CHUNKS = 8
 #: MuJoCo's mjMAXVAL: larger state entries count as diverged, as mj_checkPos/Vel do
 MAXVAL = 1e10
 
@@ -57,6 +60,21 @@ def why_not(scene, drive, controller=None) -> Optional[str]:
     return None
 
 
+def _first_bad(state0: np.ndarray, state: np.ndarray) -> tuple:
+    """(step, run): the first step of a chunk after which any run is bad, and the first such
+    run, or (len of the chunk, None). Bad: not finite or beyond mjMAXVAL (internal units keep
+    it near 1), or a step on which MuJoCo warned: the rollout then stops and repeats its
+    last state, so time stops advancing."""
+    c = state.shape[1]
+    good = (np.abs(state[:, :, 1:]) < MAXVAL).all(axis=2)          # (B, c)
+    times = np.concatenate([state0[:, :1], state[:, :, 0]], axis=1)
+    good[:, :-1] &= np.diff(times, axis=1)[:, 1:] > 0
+    if good.all():
+        return c, None
+    step = int(np.argmin(good.all(axis=0)))
+    return step, int(np.argmin(good[:, step]))
+
+
 def roll(model, state0: np.ndarray, controls, ncontrol: int, control_spec, n: int, sample_steps: np.ndarray,
          take, nthread: int = 0) -> tuple:
     """The core of both engines: ``mujoco.rollout`` of ``len(state0)`` runs of ``model`` over
@@ -65,35 +83,43 @@ def roll(model, state0: np.ndarray, controls, ncontrol: int, control_spec, n: in
     every run b at every sample step k >= 1 with its state after that step. Returns
     (final states (B, nstate), None) or, at the first bad state (not finite, beyond
     mjMAXVAL, or after a step on which MuJoCo warned), (None, (run, step, state)), after
-    taking the samples before it."""
+    taking the samples before it.
+
+    Pipelined: while the samples of one chunk are taken (Python, this thread), the next
+    chunk rolls out (C, the GIL released) on ``nthread`` threads; a chunk is at most
+    1 / PIPELINE_CHUNKS of the run, so that little of either waits for the other."""
     B = len(state0)
     nstate = mujoco.mj_stateSize(model, STATE)
-    chunk = int(max(1, min(n, CHUNK_BYTES // (8 * B * (nstate + ncontrol)))))
+    chunk = int(max(1, min(n, CHUNK_BYTES // (8 * B * (nstate + ncontrol)), -(-n // PIPELINE_CHUNKS))))
     datas = [mujoco.MjData(model) for _ in range(max(nthread, 1))]
-    control = np.zeros((B, chunk, ncontrol))
+    control = [np.zeros((B, chunk, ncontrol)) for _ in range(2)]      # one per chunk in flight
+    starts = list(range(0, n, chunk))
     i_next = 1                                      # next sample index (same for all runs)
-    with mj_rollout.Rollout(nthread=nthread) as pool:
-        for s0 in range(0, n, chunk):
+    with mj_rollout.Rollout(nthread=nthread) as pool, ThreadPoolExecutor(max_workers=1) as ahead:
+
+        def submit(j, first):
+            s0 = starts[j]
             c = min(chunk, n - s0)
-            controls(s0, c, control[:, :c])
-            state, _ = pool.rollout(model, datas, state0, control[:, :c], control_spec=control_spec, nstep=c)
-            # a state is bad if not finite or beyond mjMAXVAL (internal units keep it near 1),
-            # or if it follows a step on which MuJoCo warned: the rollout then stops and
-            # repeats its last state, so time stops advancing there
-            finite = (np.abs(state[:, :, 1:]) < MAXVAL).all(axis=2)          # (B, c)
-            times = np.concatenate([state0[:, :1], state[:, :, 0]], axis=1)
-            frozen = np.diff(times, axis=1) <= 0
-            finite[:, :-1] &= ~frozen[:, 1:]
-            bad = int(np.argmin(finite.all(axis=0))) if not finite.all() else c
+            ctl = control[j % 2][:, :c]
+            controls(s0, c, ctl)
+            return ahead.submit(lambda: pool.rollout(model, datas, first, ctl, control_spec=control_spec,
+                                                     nstep=c)[0])
+
+        pending = submit(0, state0)
+        for j, s0 in enumerate(starts):
+            state = pending.result()
+            c = state.shape[1]
+            bad, run = _first_bad(state0, state)
+            if bad == c and j + 1 < len(starts):        # the next chunk rolls while these are sampled
+                pending = submit(j + 1, np.ascontiguousarray(state[:, c - 1]))
             # samples up to the first bad step of any run
             while i_next < len(sample_steps) and sample_steps[i_next] <= s0 + bad:
                 k = int(sample_steps[i_next])
                 for b in range(B):
                     take(b, k, state[b, k - s0 - 1])
                 i_next += 1
-            if bad < c:
-                b = int(np.argmin(finite[:, bad]))
-                return None, (b, s0 + bad + 1, state[b, bad])
+            if run is not None:
+                return None, (run, s0 + bad + 1, state[run, bad])
             state0 = np.ascontiguousarray(state[:, c - 1])
     if any(x.warning[mujoco.mjtWarning.mjWARN_BADQACC].number for x in datas):
         # a warning on the very last step leaves no repeated state behind it

@@ -52,7 +52,8 @@ N / sqrt 2 segments at 2 h against the 2 h companion (Richardson, order 2; the s
 about the same in both, cancels), so the estimate is the run's own. An optimistic prior
 costs a refinement (its constants then each from its measured part); a pessimistic one
 over-resolves (nothing coarsens a model that met its target), and one that would exceed the
-step budget falls back to the question's own pilots. The shared path's estimate leans low
+step budget falls back to the question's own pilots. A batch (``rollout_batch``) runs its
+pilots on its first member alone and measures every member the same way (``pilot_run``). The shared path's estimate leans low
 where Richardson's step part does (pre-asymptotic rates under 'discrete'): measured 0.38 to
 1.3 x the true error on the test's question, against 0.93 to 3.9 x with pilots, whose a
 carries some of the step's error. On the 11 seeded cases below, each from priors 4 x off
@@ -234,7 +235,7 @@ class _Runner:
         self.scene, self.run_fn, self.grid = scene, run, grid
         self.runs: List[dict] = []
 
-    def __call__(self, model: Model, role: str):
+    def __call__(self, model: Model, role: str, run=None):
         try:
             s = self.scene.variant(model.segments, model.timestep, model.integrator)
         except ParameterError:
@@ -243,7 +244,7 @@ class _Runner:
             model = Model(model.segments, model.timestep, "discrete")     # beyond its stability limit
             s = self.scene.variant(model.segments, model.timestep, model.integrator)
         t0 = _time.perf_counter()
-        out = self.run_fn(s, self.grid)
+        out = (run or self.run_fn)(s, self.grid)
         self.runs.append({"role": role, **asdict(model), "wall_time_s": _time.perf_counter() - t0})
         return s, model, out
 
@@ -252,14 +253,15 @@ def _each(results) -> list:
     return results if isinstance(results, list) else [results]
 
 
-def calibrate(runner: _Runner, h_pilot: float) -> ErrorModel:
+def calibrate(runner: _Runner, h_pilot: float, run=None) -> ErrorModel:
     """The constants from three pilots: a from PILOT_SEGMENTS at one step h (the step's error
-    cancels), b from the coarser at h and h / 2 (the segments' error cancels)."""
+    cancels), b from the coarser at h and h / 2 (the segments' error cancels); ``run``: the
+    pilots' own run function (a batch's first member), else the runner's."""
     n1, n2 = PILOT_SEGMENTS
     integ = _integrator_for(runner.scene, h_pilot / 2)
-    _, _, coarse = runner(Model(n1, h_pilot, integ), "pilot")
-    _, _, fine = runner(Model(n2, h_pilot, integ), "pilot")
-    _, _, half = runner(Model(n1, _on_grid(h_pilot / 2, runner.grid), integ), "pilot")
+    _, _, coarse = runner(Model(n1, h_pilot, integ), "pilot", run)
+    _, _, fine = runner(Model(n2, h_pilot, integ), "pilot", run)
+    _, _, half = runner(Model(n1, _on_grid(h_pilot / 2, runner.grid), integ), "pilot", run)
     a = max([relative_difference(f, c) for f, c in zip(_each(fine), _each(coarse))]) / (n1 ** -2 - n2 ** -2)
     h_half = runner.runs[-1]["timestep"]
     b = max([relative_difference(f, c) for f, c in zip(_each(half), _each(coarse))]) / (h_pilot - h_half)
@@ -349,13 +351,15 @@ def as_error_model(value) -> ErrorModel:
 
 
 def run_at_accuracy(scene, run, *, accuracy: float, duration: float, wave=None,
-                    sample_interval: Optional[float] = None, error_model=None):
+                    sample_interval: Optional[float] = None, error_model=None, pilot_run=None):
     """Choose, run and check a model of ``scene`` for ``accuracy``. ``run(scene, interval)``
     runs one model sampled every ``interval`` s and returns a RolloutResult (or a list of
     them, a batch: the model then serves its worst member). ``error_model`` (an ErrorModel
     or (a, b), e.g. another question's ``meta['accuracy']['error_model']``: a sweep's
     earlier point) replaces the pilots; the segments' error is then measured on the run
-    (:func:`fewer_segments`), not taken from a. Returns (result(s), scene of the chosen
+    (:func:`fewer_segments`), not taken from a. ``pilot_run`` (a batch: ``run`` for its
+    first member only) runs the pilots on that member alone, the others then measured as
+    with a given error model. Returns (result(s), scene of the chosen
     model, report dict), the report also put in each result's ``meta['accuracy']``."""
     target = check_accuracy(accuracy)
     given = None if error_model is None else as_error_model(error_model)
@@ -366,16 +370,17 @@ def run_at_accuracy(scene, run, *, accuracy: float, duration: float, wave=None,
     h_cap = _step_cap(scene, wave, grid)
     runner = _Runner(scene, run, grid)
     h_pilot = _on_grid(min(h_cap, PILOT_STEP * scene.choice.rayleigh_beta), grid)
-    em = calibrate(runner, h_pilot) if given is None else given
-    measure = given is not None
+    em = calibrate(runner, h_pilot, pilot_run) if given is None else given
+    measure = given is not None or pilot_run is not None
     model = choose_model(scene, em, target, duration, grid, h_cap)
-    if measure:
+    if given is not None:
         try:
             _check_work(model, duration, target, em, "given")
         except ParameterError:      # a prior too pessimistic for this question: its own pilots decide
-            measure, em = False, calibrate(runner, h_pilot)
+            given, em = None, calibrate(runner, h_pilot, pilot_run)
+            measure = pilot_run is not None
             model = choose_model(scene, em, target, duration, grid, h_cap)
-    if not measure:
+    if given is None:
         _check_work(model, duration, target, em, "pilots of this question")
     chosen, model, result, parts = _run_with_companions(runner, model, "chosen", em.spatial, measure)
     estimates = _combined(parts)
@@ -399,8 +404,8 @@ def run_at_accuracy(scene, run, *, accuracy: float, duration: float, wave=None,
                    if measure else
                    f"segments: a / N^2 = {em.spatial / model.segments ** 2:.3g} (pilots)")
     pilots = (f"given (a = {given.spatial:.4g}, b = {given.temporal:.4g} 1/s), not calibrated on this run"
-              if measure else f"{PILOT_SEGMENTS[0]} and {PILOT_SEGMENTS[1]} segments at {h_pilot:.4g} s, "
-              f"{PILOT_SEGMENTS[0]} at half that")
+              if given is not None else f"{PILOT_SEGMENTS[0]} and {PILOT_SEGMENTS[1]} segments at {h_pilot:.4g} s, "
+              f"{PILOT_SEGMENTS[0]} at half that" + (", on the batch's first member" if pilot_run is not None else ""))
     report = {"quantity": QUANTITY, "target": target, "model": asdict(model),
               "predicted_error": em.predict(model), "estimated_error": max(estimates), "met": met,
               "estimate": "step: Richardson with the observed rate against companions of "

@@ -168,8 +168,10 @@ def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable
     or its moment history as applied forces (``threaded``); ``auto`` takes the first that
     applies. Same results as :func:`rollout` run one by one with that
     engine; raises ParameterError where neither applies. ``accuracy`` (default: the
-    scene's own): one model is chosen for the whole batch, for its worst member
-    (:mod:`mjeap.simulation.accuracy`), and each result carries its own estimated error."""
+    scene's own): one model is chosen for the whole batch, from the pilots of its first
+    member and then for its worst member (:mod:`mjeap.simulation.accuracy`: each member's
+    error is measured on it, segments and step), and each result carries its own estimated
+    error."""
     from ..drives import make_drive
     duration = check_positive("duration", duration, "s")
     if np.ndim(initial_curvatures) == 0:
@@ -198,11 +200,13 @@ def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable
         fastest = max(waves, key=lambda w: getattr(w, "max_frequency", 0.0) or 0.0)
         make_drive(drive, scene, **(drive_params or {}))          # the drive's parameters, checked first
 
-        def run(s, interval):
-            return rollout_batch(s, voltages, duration, drive=drive, drive_params=drive_params,
-                                 initial_curvatures=kappa0, sample_interval=interval, nthread=nthread, engine=engine)
+        def run(s, interval, members=slice(None)):
+            return rollout_batch(s, voltages[members], duration, drive=drive, drive_params=drive_params,
+                                 initial_curvatures=kappa0[members], sample_interval=interval, nthread=nthread,
+                                 engine=engine)
         return run_at_accuracy(scene, run, accuracy=target, duration=duration, wave=fastest,
-                               sample_interval=sample_interval)[0]
+                               sample_interval=sample_interval,
+                               pilot_run=(lambda s, i: run(s, i, slice(1))) if len(voltages) > 1 else None)[0]
     drives = [make_drive(drive, scene, **(drive_params or {})) for _ in voltages]
     eng, _ = choose(engine, scene, drives[0], None, batched=True)
     dt = scene.timestep
