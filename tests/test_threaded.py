@@ -120,6 +120,7 @@ def test_pipelined_chunks_change_nothing(monkeypatch, engine):
     s = Scene("ppy-trilayer")
     waves, k0 = ["square:0.5V@0.5Hz", "sine:0.3V@1Hz"], [0.0, 20.0]
     kw = dict(initial_curvatures=k0, nthread=2, engine=engine)
+    monkeypatch.setattr(threaded, "PIPELINE_MIN_STEPS", 1)
     monkeypatch.setattr(threaded, "PIPELINE_CHUNKS", 1)
     one = rollout_batch(s, waves, 2.0, **kw)
     for chunks in (7, 64):

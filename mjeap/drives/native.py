@@ -81,6 +81,14 @@ def add_maxwell_arms(spec: mujoco.MjSpec, joints, parent: str, k, zero: float, p
     implicit under ``implicitfast``; the relaxation dof's armature is RELAXATION_INERTIA x
     (timestep x damping), so the arm is first order to 1e-3 of a step; its body (on the
     hinge axis, under ``parent``) weighs RELAXATION_BODY_MASS x ``link_mass``.
+
+    Cost, measured on seed 000's 20-hinge beam (MuJoCo 3.17, this 2-core machine, mj_step):
+    bare beam 5.5 us, with the drive's tendon and actuator 6.4, with the arms 9.2-9.5; of
+    the arms, their 20 dofs take 2.4 us and their 20 tendons 0.7; their bodies nothing
+    measurable (six arms' joints on one body: the same time). The tendon-free form, a second
+    hinge on every link (a spring in series with a spring-damper), puts the 20 extra dofs
+    into the chain (a dense 40-dof mass matrix): 13.1 us. MuJoCo keeps no per-joint state
+    without a dof, so these arms are the cheapest exact form found.
     """
     k = np.asarray(k, dtype=float)
     k1 = k * (zero - pole) / zero

@@ -19,7 +19,9 @@ which replays the drive's own step), so they are the lockstep loop's read-outs e
 """
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import Future, ThreadPoolExecutor
+from contextlib import nullcontext
+from functools import partial
 from typing import List, Optional, Sequence
 
 import mujoco
@@ -35,8 +37,9 @@ NATIVE_CONTROL = mujoco.mjtState.mjSTATE_CTRL
 LOADS = mujoco.mjtState.mjSTATE_XFRC_APPLIED
 #: the state and control arrays of one chunk stay below this size
 CHUNK_BYTES = 64 * 2**20
-#: a run goes in at least this many chunks (the pipeline of :func:`roll`)
-PIPELINE_CHUNKS = 8
+#: a run goes in at least this many chunks (the pipeline of :func:`roll`), each of at least
+#: PIPELINE_MIN_STEPS steps over all its runs (a chunk costs ~0.1 ms to hand over)
+PIPELINE_CHUNKS, PIPELINE_MIN_STEPS = 8, 20_000
 #: MuJoCo's mjMAXVAL: larger state entries count as diverged, as mj_checkPos/Vel do
 MAXVAL = 1e10
 
@@ -87,27 +90,34 @@ def roll(model, state0: np.ndarray, controls, ncontrol: int, control_spec, n: in
 
     Pipelined: while the samples of one chunk are taken (Python, this thread), the next
     chunk rolls out (C, the GIL released) on ``nthread`` threads; a chunk is at most
-    1 / PIPELINE_CHUNKS of the run, so that little of either waits for the other."""
+    1 / PIPELINE_CHUNKS of the run (short runs go in one), so that little of either waits
+    for the other."""
     B = len(state0)
     nstate = mujoco.mj_stateSize(model, STATE)
-    chunk = int(max(1, min(n, CHUNK_BYTES // (8 * B * (nstate + ncontrol)), -(-n // PIPELINE_CHUNKS))))
+    chunk = int(max(1, min(n, CHUNK_BYTES // (8 * B * (nstate + ncontrol)),
+                           max(-(-n // PIPELINE_CHUNKS), -(-PIPELINE_MIN_STEPS // B)))))
     datas = [mujoco.MjData(model) for _ in range(max(nthread, 1))]
-    control = [np.zeros((B, chunk, ncontrol)) for _ in range(2)]      # one per chunk in flight
     starts = list(range(0, n, chunk))
+    control = [np.zeros((B, chunk, ncontrol)) for _ in starts[:2]]    # one per chunk in flight
     i_next = 1                                      # next sample index (same for all runs)
-    with mj_rollout.Rollout(nthread=nthread) as pool, ThreadPoolExecutor(max_workers=1) as ahead:
+    with mj_rollout.Rollout(nthread=nthread) as pool, \
+            (ThreadPoolExecutor(max_workers=1) if len(starts) > 1 else nullcontext()) as ahead:
 
         def submit(j, first):
             s0 = starts[j]
             c = min(chunk, n - s0)
             ctl = control[j % 2][:, :c]
             controls(s0, c, ctl)
-            return ahead.submit(lambda: pool.rollout(model, datas, first, ctl, control_spec=control_spec,
-                                                     nstep=c)[0])
+            job = partial(pool.rollout, model, datas, first, ctl, control_spec=control_spec, nstep=c)
+            if ahead is None:                   # one chunk: nothing to overlap
+                done = Future()
+                done.set_result(job())
+                return done
+            return ahead.submit(job)
 
         pending = submit(0, state0)
         for j, s0 in enumerate(starts):
-            state = pending.result()
+            state = pending.result()[0]
             c = state.shape[1]
             bad, run = _first_bad(state0, state)
             if bad == c and j + 1 < len(starts):        # the next chunk rolls while these are sampled
