@@ -120,8 +120,9 @@ def roll(model, state0: np.ndarray, controls, ncontrol: int, control_spec, n: in
             state = pending.result()[0]
             c = state.shape[1]
             bad, run = _first_bad(state0, state)
+            last = np.ascontiguousarray(state[:, c - 1])
             if bad == c and j + 1 < len(starts):        # the next chunk rolls while these are sampled
-                pending = submit(j + 1, np.ascontiguousarray(state[:, c - 1]))
+                pending = submit(j + 1, last)
             # samples up to the first bad step of any run
             while i_next < len(sample_steps) and sample_steps[i_next] <= s0 + bad:
                 k = int(sample_steps[i_next])
@@ -130,7 +131,7 @@ def roll(model, state0: np.ndarray, controls, ncontrol: int, control_spec, n: in
                 i_next += 1
             if run is not None:
                 return None, (run, s0 + bad + 1, state[run, bad])
-            state0 = np.ascontiguousarray(state[:, c - 1])
+            state0 = last
     if any(x.warning[mujoco.mjtWarning.mjWARN_BADQACC].number for x in datas):
         # a warning on the very last step leaves no repeated state behind it
         return None, (B - 1, n, None)

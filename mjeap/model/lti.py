@@ -28,13 +28,13 @@ def lsim(system: signal.TransferFunction, u, t, interp: bool = True) -> np.ndarr
     dt = (t[-1] - t[0]) / (len(t) - 1)
     if not (dt > 0 and np.allclose(np.diff(t), dt, rtol=1e-9, atol=0.0)):
         return signal.lsim(system, u, t, interp=interp)[1]
-    tf = (system.num, system.den)
-    num, den, _ = signal.cont2discrete(tf, dt, method="zoh")
+    def filtered(method, x):
+        num, den, _ = signal.cont2discrete((system.num, system.den), dt, method=method)
+        return signal.lfilter(np.atleast_2d(num)[0], den, x)
+
     if not interp:
-        return signal.lfilter(np.atleast_2d(num)[0], den, u)
+        return filtered("zoh", u)
     # linear interpolation from rest: the first sample held (exact under zero-order hold)
     # plus the interpolated rest, which starts at zero (so the first-order-hold state,
     # x - B1 u, starts at zero too and lfilter's rest is the system's)
-    y = signal.lfilter(np.atleast_2d(num)[0], den, np.full_like(u, u[0]))
-    num, den, _ = signal.cont2discrete(tf, dt, method="foh")
-    return y + signal.lfilter(np.atleast_2d(num)[0], den, u - u[0])
+    return filtered("zoh", np.full_like(u, u[0])) + filtered("foh", u - u[0])
