@@ -33,16 +33,26 @@ def main(argv=None):
     ap.add_argument("--accuracy", type=float, default=None,
                     help="tip-curvature error relative to its swing (1e-5 to 0.2) each point is run at: segments, "
                          "integrator and timestep chosen per point, the estimate in the estimated_error column")
+    ap.add_argument("--stop-when-periodic", type=float, default=None, metavar="TOL",
+                    help="stop a point once its last drive period repeats the one before within TOL (1e-6 to 0.2, "
+                         "of the tip curvature's range and of the length): its outcome is decided; the "
+                         "stopped_early column says where (from the second period's end on: the map's 30 s "
+                         "points can stop at 20 s)")
     a = parse_args(ap, argv)
     if a.accuracy is not None:
         from .simulation.accuracy import check_accuracy
         check_accuracy(a.accuracy)
+    if a.stop_when_periodic is not None:
+        from .errors import check_range
+        check_range("--stop-when-periodic", a.stop_when_periodic, 1e-6, 0.2)
     out = Path(a.out)
     masses = np.linspace(0.0, 150e-6, a.masses)[1:]
     amps = np.linspace(0.25, 1.5, a.amplitudes)
     points = grid(payload_mass=[float(m) for m in masses], amplitude=[float(v) for v in amps])
-    metrics = ("returns", "peak_to_peak", "max_stress_proxy") + (("estimated_error",) if a.accuracy else ())
-    base = {**MAP_BASE, **({"accuracy": a.accuracy} if a.accuracy else {})}
+    metrics = ("returns", "peak_to_peak", "max_stress_proxy") + (("estimated_error",) if a.accuracy else ()) + \
+        (("stopped_early",) if a.stop_when_periodic else ())
+    base = {**MAP_BASE, **({"accuracy": a.accuracy} if a.accuracy else {}),
+            **({"stop_when_periodic": a.stop_when_periodic} if a.stop_when_periodic else {})}
     s = run_sweep(points, out / "results.csv", metrics=metrics, base=base,
                   executor=a.executor, workers=a.workers)
     print(f"{s.done} rollouts in {s.wall_s:.1f} s ({s.throughput:.2f}/s), {s.skipped} already done, {s.failed} failed")

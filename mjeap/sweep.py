@@ -42,7 +42,7 @@ PARAMETERS: Dict[str, object] = {
     "actuator": "pedot-micro", "representation": "hinge", "segments": 20, "orientation": "horizontal",
     "payload_mass": 0.0, "payload_position": None, "waveform": "square", "amplitude": 1.0, "frequency": 0.1,
     "offset": 0.0, "duration": None, "initial_curvature": 0.0, "damping_ratio": None, "engine": "auto",
-    "accuracy": None,
+    "accuracy": None, "stop_when_periodic": None,
 }
 
 
@@ -101,8 +101,15 @@ def metric_estimated_error(r, point, scene) -> str:
             f"{how}, {a.get('refinements', 0)} refinements)")
 
 
+def metric_stopped_early(r, point, scene) -> str:
+    """Where and why the point stopped before its duration (``stop_when_periodic``: its
+    last period repeated the one before; :mod:`mjeap.simulation.periodic`), '' where it ran
+    to the end."""
+    return r.meta.get("stopped_early", "")
+
+
 METRICS: Dict[str, Callable] = {
-    "estimated_error": metric_estimated_error,
+    "estimated_error": metric_estimated_error, "stopped_early": metric_stopped_early,
     "peak_to_peak": metric_peak_to_peak, "returns": metric_returns, "settling_time": metric_settling_time,
     "max_stress_proxy": metric_max_stress_proxy, "max_tip_deflection": metric_max_tip_deflection,
 }
@@ -224,7 +231,9 @@ def evaluate(point: dict, metrics: Sequence[str] = ("peak_to_peak", "returns"), 
         rrd = None if rrd_dir is None else Path(rrd_dir) / f"point-{row['point_id']}.rrd"
         r = rollout(scene, wave, float(duration), drive_params=drive_params, initial_curvature=float(p["initial_curvature"]),
                     progress=False, rrd=rrd, engine=p["engine"],
-                    error_model=error_model if scene.accuracy is not None else None)
+                    error_model=error_model if scene.accuracy is not None else None,
+                    stop_when_periodic=None if p["stop_when_periodic"] in (None, "") else
+                    float(p["stop_when_periodic"]))
         if "accuracy" in r.meta:
             e = r.meta["accuracy"].get("error_model")
             row["_error_model"] = None if e is None else (e["spatial_a"], e["temporal_b_per_s"])

@@ -65,3 +65,31 @@ def test_payloads_inverted_stay_finite_and_increase_the_swing(capsys):
         assert p2p > 1.02 * unloaded[vpp]
     with capsys.disabled():
         print("\nseed 000 payload runs (second period):\n" + json.dumps(rows, indent=1))
+
+
+def test_direct_step_is_the_general_step(monkeypatch):
+    """Seed 000's drive writes its moments straight into the hinge chain's qfrc_applied
+    (Part.direct_bending); the general path (set_internal_moments and the state vector) must
+    give the same run: curvature, tip and every signal, with gravity, a payload and a
+    square wave, to rounding."""
+    from mjeap.simulation.part import ActuatorPart
+
+    def run():
+        s = Scene("pedot-micro", orientation="up", payload=Payload(40e-6, 6.27e-3), segments=8)
+        r = rollout(s, "square:1.5V@0.5Hz", 2.0, engine="loop", initial_curvature=-100.0, progress=False)
+        return s, r
+
+    s, direct = run()
+    assert s.part.direct_bending() is not None
+    monkeypatch.setattr(ActuatorPart, "direct_bending", lambda self: None)
+    _, general = run()
+    swing = np.ptp(general.tip_curvature)
+    assert np.max(np.abs(direct.tip_curvature - general.tip_curvature)) < 1e-9 * swing
+    assert np.allclose(direct.tip_position, general.tip_position, rtol=0, atol=1e-12)
+    for k, g in general.signals.items():
+        assert np.allclose(direct.signals[k], g, rtol=1e-9, atol=1e-12 * np.max(np.abs(g))), k
+
+
+def test_direct_step_only_where_the_moments_are_the_joints_own():
+    """The cable's moments follow its geometry: no direct path there (the general one runs)."""
+    assert Scene("pedot-micro", representation="cable", segments=8).part.direct_bending() is None

@@ -11,6 +11,7 @@ with ``mjeap.rollout(..., drive="my-drive")`` without touching the package.
 """
 from __future__ import annotations
 
+import functools
 from typing import ClassVar, Dict, Optional, Tuple, Type
 
 import numpy as np
@@ -50,6 +51,7 @@ def make_drive(name: Optional[str], scene, **params) -> "Drive":
     return get_drive_class(name)(scene, **params)
 
 
+@functools.lru_cache(maxsize=1024)
 def zoh_first_order(pole: float, gain: float, dt: float) -> Tuple[float, float]:
     """x' = -pole x + gain u stepped exactly over ``dt`` s with u held (zero-order hold,
     scipy.signal.cont2discrete): returns (a, b) of x+ = a x + b u."""

@@ -70,6 +70,9 @@ class RCRelaxationDrive(NativeForm, Drive):
         self._r, self._theta = self._s[:n], self._u[:n]      # views
         self._m_relax, self._m_total = np.empty(n), np.empty(n)
         self._v = self._m_drive = 0.0
+        # the same update as scalars (uniform over the hinges), for the direct path
+        self._ar, self._br, self._ae, self._be = a_r, b_r, a_e, b_e
+        self._direct, self._stale = None, False
 
     def reset(self, initial_curvature: float = 0.0) -> None:
         """Start at rest at the scene's current shape: the relaxation state holds it (zero
@@ -82,6 +85,14 @@ class RCRelaxationDrive(NativeForm, Drive):
         self._v = 0.0
         self._k = sc.hinge_stiffness()
         self._apply()
+        self._stale = False
+        d = sc.direct_bending()
+        if d is not None:       # moments in internal units straight into qfrc_applied
+            theta, qfrc, scale = d
+            self._direct = (sc.data, theta, qfrc, self._k * scale, self.gamma * scale, np.empty_like(self._r),
+                            1.0 / scale)
+        else:
+            self._direct = None
 
     def _apply(self):
         """Moments over the coming step: k r (relaxation) + Gamma v_c (drive), N m."""
@@ -92,6 +103,21 @@ class RCRelaxationDrive(NativeForm, Drive):
 
     def step(self, voltage: float, dt: float) -> None:
         self._v = voltage
+        if self._direct is not None and self._direct[0] is self.part.data:
+            # :meth:`_apply` and the update below written into the model's own arrays
+            # (Part.direct_bending): the same arithmetic in 5 array operations
+            _, theta, qfrc, k, gamma, tmp, _ = self._direct
+            r, s = self._r, self._s
+            vc = float(s[-1])
+            np.multiply(k, r, out=qfrc)
+            qfrc += gamma * vc
+            r *= self._ar
+            np.multiply(theta, self._br, out=tmp)
+            r += tmp
+            s[-1] = self._ae * vc + self._be * voltage
+            self._m_drive = self.gamma * vc
+            self._stale = True
+            return
         self._apply()
         self.part.hinge_angles(out=self._theta)
         self._u[-1] = voltage
@@ -102,6 +128,11 @@ class RCRelaxationDrive(NativeForm, Drive):
     def signals(self) -> Dict[str, float]:
         C = self.params["capacitance"]
         vc = float(self._s[-1])
+        if self._stale:       # after direct steps: the relaxation moments that acted over the last one
+            _, _, qfrc, _, _, _, newton_metre = self._direct
+            np.multiply(qfrc, newton_metre, out=self._m_relax)
+            self._m_relax -= self._m_drive
+            self._stale = False
         return {"double_layer_voltage (V)": vc, "charge (C)": C * vc,
                 "current (A)": C * self.params["pole_electrical"] * (self._v - vc),
                 "drive_moment (N m)": float(self._m_drive),
@@ -161,6 +192,7 @@ class RCRelaxationDrive(NativeForm, Drive):
         self._s[-1] = part.data.act[aadr]
         self._v = float(self._v_native[max(k - 1, 0)]) if k else 0.0
         self._m_drive = self.gamma * float(self._s[-1])
+        self._stale = False
         k1 = part.hinge_stiffness() * (z - pm) / z
         np.multiply(k1, part.data.qpos[qadr], out=self._m_relax)
         return self.signals()

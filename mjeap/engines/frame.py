@@ -21,11 +21,22 @@ from ..errors import ParameterError, check_range
 from ..io.outputs import replacing
 from ..drives.waveforms import Waveform, parse_waveform
 
-__all__ = ["RolloutResult", "Samples", "MAX_STEPS", "DEFAULT_SAMPLES", "check_work", "check_sampling",
+__all__ = ["RolloutResult", "Decided", "Samples", "MAX_STEPS", "DEFAULT_SAMPLES", "check_work", "check_sampling",
            "voltage_steps", "to_waveform", "one_voltage", "check_initial_curvature", "sample_steps", "lockstep"]
 
 #: at most this many samples are kept per rollout unless sample_interval is given
 DEFAULT_SAMPLES = 5000
+
+
+class Decided(Exception):
+    """A run's outcome is decided at a sample: ``reason`` (words), ``time`` (s); the
+    engines add ``step`` and ``state`` (their full physics state there, when they roll out
+    ahead)."""
+
+    def __init__(self, reason: str, time: float):
+        super().__init__(reason)
+        self.reason, self.time = reason, time
+        self.step, self.state = None, None
 
 
 @dataclass
@@ -86,6 +97,9 @@ class Samples:
         self.t, self.v = np.empty(ns), np.empty(ns)
         self.sig: Dict[str, np.ndarray] = {}
         self.n = 0                                  # samples taken
+        #: called with this store after every sample; may raise a decision to stop the run
+        #: (:class:`mjeap.simulation.periodic.PeriodicStop`)
+        self.stop = None
 
     def _put(self, key, i, value):
         if key not in self.sig:
@@ -113,13 +127,22 @@ class Samples:
             for k, x in controller.signals().items():
                 self._put(f"controller_{k}", i, x)
         self.n += 1
+        if self.stop is not None:
+            self.stop(self)
 
-    def _to_clamp(self, raw: np.ndarray, xmat: np.ndarray):
-        """Clamp-frame points (m) and tip angles (rad) of raw samples."""
+    def clamp_frame(self, idx: np.ndarray):
+        """Clamp-frame points (m; clamp, hinges, tip[, payload]) and tip angles (rad) of the
+        samples ``idx`` taken so far (copies; the store is left as it is)."""
+        raw = self._raw[idx] - self._raw[idx, :1]
+        return self._to_clamp(raw, self._xmat[idx], None if self._clamp_xmat is None else self._clamp_xmat[idx])
+
+    def _to_clamp(self, raw: np.ndarray, xmat: np.ndarray, clamp_xmat=None):
+        """Clamp-frame points (m) and tip angles (rad) of raw samples (the first ones, or
+        those whose clamp orientations are ``clamp_xmat``)."""
         p = self.part
         if not self._moving:
             return p.clamp_frame(raw), p.in_plane_angle(xmat)
-        R = self._clamp_xmat[:len(raw)].reshape(-1, 3, 3)
+        R = (self._clamp_xmat[:len(raw)] if clamp_xmat is None else clamp_xmat).reshape(-1, 3, 3)
         pts = np.einsum("n...j,njk->n...k", raw, R) * p.units.length
         rel = np.einsum("nji,njk->nik", R, xmat.reshape(-1, 3, 3))
         return pts, np.arctan2(rel[:, 1, 0], rel[:, 0, 0])

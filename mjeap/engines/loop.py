@@ -15,7 +15,7 @@ import numpy as np
 
 from ..errors import DivergenceError
 from .base import Engine
-from .frame import lockstep, one_voltage
+from .frame import Decided, lockstep, one_voltage
 
 try:  # progress bars are optional
     from tqdm import tqdm
@@ -91,22 +91,30 @@ def run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, prog
     m, d = scene.model, scene.data
     drive_step = drv.step
 
-    def before(k):
-        if controller is not None:
-            if k % ctrl_every == 0:
-                scene.update_kinematics()
-                u = controller(k * dt, scene)
-                if not isinstance(u, float) or not math.isfinite(u):
-                    u = one_voltage(u, "controller command", f"{ctrl_name} at t = {k * dt:.6g} s")
-                state["hold"] = min(max(u, v_lo), v_hi)
-                state["saturated"] += state["hold"] != u
-            v_steps[k] = state["hold"]
+    def closed_loop(k):
+        if k % ctrl_every == 0:
+            scene.update_kinematics()
+            u = controller(k * dt, scene)
+            if not isinstance(u, float) or not math.isfinite(u):
+                u = one_voltage(u, "controller command", f"{ctrl_name} at t = {k * dt:.6g} s")
+            state["hold"] = min(max(u, v_lo), v_hi)
+            state["saturated"] += state["hold"] != u
+        v_steps[k] = state["hold"]
         drive_step(v_steps[k], dt)
+
+    voltage_at = v_steps.item      # a Python float: cheaper to take and to multiply
+
+    def open_loop(k):
+        drive_step(voltage_at(k), dt)
 
     def sample(i, step):
         scene.update_kinematics()
-        samples.take(step * dt, state["hold"] if controller is not None else v_steps[max(step - 1, 0)],
-                     drv.signals(), controller)
+        try:
+            samples.take(step * dt, state["hold"] if controller is not None else v_steps[max(step - 1, 0)],
+                         drv.signals(), controller)
+        except Decided as stop:         # the run ends here (Samples.stop): the scene is in its state
+            stop.step = scene._step_count = step
+            raise
 
     def check(done, k):
         try:
@@ -117,7 +125,7 @@ def run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, prog
             raise divergence_error(scene, drv, v_steps[k], done, who) from None
 
     try:
-        lockstep(m, d, n_steps, sample_steps, before, sample, check, check_every,
+        lockstep(m, d, n_steps, sample_steps, open_loop if controller is None else closed_loop, sample, check, check_every,
                  None if bar is None else bar.update)
     finally:
         if bar is not None:

@@ -10,7 +10,8 @@ import numpy as np
 
 from ..drives.base import NativeForm
 from .base import CONTROLLER_REASON, Engine
-from .threaded import LOADS, NATIVE_CONTROL, STATE, raise_bad, roll
+from .frame import Decided
+from .threaded import LOADS, NATIVE_CONTROL, STATE, ahead_of_stop, raise_bad, roll
 
 
 def why_not(scene, drive, controller=None) -> Optional[str]:
@@ -88,8 +89,13 @@ def run_native(scene, native, drives: Sequence, v_steps: Sequence[np.ndarray], i
             rows[b][samples[b].n] = state
         samples[b].take(k * dt, v_steps[b][k - 1], {} if batch[b] else drives[b].native_signals(k, part, h))
 
+    decided = None
     try:
-        final, bad = roll(m, state0, controls, len(template), spec, n, sample_steps, take, nthread)
+        try:
+            final, bad = roll(m, state0, controls, len(template), spec, n, sample_steps, take, nthread,
+                              ahead_of_stop(samples, dt))
+        except Decided as stop:         # the run ends at the decision (Samples.stop)
+            final, bad, n, decided = stop.state[None], None, stop.step, stop
         if bad is not None:
             raise_bad(scene, put, drives, v_steps, bad)
         put(final[-1])
@@ -105,3 +111,5 @@ def run_native(scene, native, drives: Sequence, v_steps: Sequence[np.ndarray], i
     mujoco.mj_kinematics(m, d)
     drives[-1].native_leave(n, part, h)
     scene._step_count = n
+    if decided is not None:
+        raise decided

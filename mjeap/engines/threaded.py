@@ -30,6 +30,7 @@ from mujoco import rollout as mj_rollout
 
 from ..errors import DivergenceError
 from .base import CONTROLLER_REASON, Engine
+from .frame import Decided
 
 STATE = mujoco.mjtState.mjSTATE_FULLPHYSICS
 CONTROL = mujoco.mjtState.mjSTATE_QFRC_APPLIED
@@ -79,7 +80,7 @@ def _first_bad(state0: np.ndarray, state: np.ndarray) -> tuple:
 
 
 def roll(model, state0: np.ndarray, controls, ncontrol: int, control_spec, n: int, sample_steps: np.ndarray,
-         take, nthread: int = 0) -> tuple:
+         take, nthread: int = 0, max_chunk: Optional[int] = None) -> tuple:
     """The core of both engines: ``mujoco.rollout`` of ``len(state0)`` runs of ``model`` over
     ``n`` steps, in chunks that keep memory bounded. ``controls(s0, c, out)`` fills the
     (B, c, ncontrol) controls of steps s0 .. s0 + c; ``take(b, k, state)`` is called for
@@ -91,11 +92,12 @@ def roll(model, state0: np.ndarray, controls, ncontrol: int, control_spec, n: in
     Pipelined: while the samples of one chunk are taken (Python, this thread), the next
     chunk rolls out (C, the GIL released) on ``nthread`` threads; a chunk is at most
     1 / PIPELINE_CHUNKS of the run (short runs go in one), so that little of either waits
-    for the other."""
+    for the other. ``max_chunk`` (steps) caps a chunk: a run that may stop at a sample
+    (Samples.stop) rolls out at most that far ahead of it."""
     B = len(state0)
     nstate = mujoco.mj_stateSize(model, STATE)
     chunk = int(max(1, min(n, CHUNK_BYTES // (8 * B * (nstate + ncontrol)),
-                           max(-(-n // PIPELINE_CHUNKS), -(-PIPELINE_MIN_STEPS // B)))))
+                           max(-(-n // PIPELINE_CHUNKS), -(-PIPELINE_MIN_STEPS // B)), max_chunk or n)))
     datas = [mujoco.MjData(model) for _ in range(max(nthread, 1))]
     starts = list(range(0, n, chunk))
     control = [np.zeros((B, chunk, ncontrol)) for _ in starts[:2]]    # one per chunk in flight
@@ -127,7 +129,11 @@ def roll(model, state0: np.ndarray, controls, ncontrol: int, control_spec, n: in
             while i_next < len(sample_steps) and sample_steps[i_next] <= s0 + bad:
                 k = int(sample_steps[i_next])
                 for b in range(B):
-                    take(b, k, state[b, k - s0 - 1])
+                    try:
+                        take(b, k, state[b, k - s0 - 1])
+                    except Decided as stop:     # the run ends here: its state goes with the decision
+                        stop.step, stop.state = k, np.array(state[b, k - s0 - 1])
+                        raise
                 i_next += 1
             if run is not None:
                 return None, (run, s0 + bad + 1, state[run, bad])
@@ -169,7 +175,11 @@ def run(scene, drives: Sequence, v_steps: Sequence[np.ndarray], initial_curvatur
         drives[b].seek(k)
         samples[b].take(k * dt, v_steps[b][k - 1], drives[b].signals())
 
-    final, bad = roll(m, state0, controls, nv, CONTROL, n, sample_steps, take, nthread)
+    try:
+        final, bad = roll(m, state0, controls, nv, CONTROL, n, sample_steps, take, nthread, ahead_of_stop(samples, dt))
+        decided = None
+    except Decided as stop:             # the run ends at the decision (Samples.stop)
+        final, bad, n, decided = stop.state[None], None, stop.step, stop
     if bad is not None:
         raise_bad(scene, lambda x: mujoco.mj_setState(m, d, x, STATE), drives, v_steps, bad)
     # leave the scene and the (last) drive as the lockstep loop does: final state, the
@@ -178,6 +188,15 @@ def run(scene, drives: Sequence, v_steps: Sequence[np.ndarray], initial_curvatur
     drives[-1].seek(n)
     scene._step_count = n
     scene.update_kinematics()
+    if decided is not None:
+        raise decided
+
+
+def ahead_of_stop(samples, dt: float) -> Optional[int]:
+    """The chunk (steps) of a run that may stop early: a tenth of the stop's period (the
+    steps rolled out past a stop are wasted), else None."""
+    stop = samples[0].stop if len(samples) == 1 else None
+    return None if stop is None else max(1, int(0.1 * stop.period / dt))
 
 
 def raise_bad(scene, put, drives, v_steps, bad) -> None:

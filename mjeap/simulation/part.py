@@ -144,6 +144,20 @@ class ActuatorPart:
     #: the last internal moments (N m) where they must follow the geometry, else None
     _moments = None
 
+    def direct_bending(self):
+        """(angles, moments, scale) for a drive's per-step path, or None: a view of the hinge
+        angles (rad, in ``qpos``), a view of the hinges' bending forces (internal units, in
+        ``qfrc_applied``) and the internal value of 1 N m, so that writing ``M * scale`` into
+        ``moments`` is :meth:`set_internal_moments` (M) without its checks. Only where the
+        hinges are evenly spaced joints whose moments do not follow the geometry and whose
+        stiffness is the model's own; the views are valid until the part is bound again."""
+        v = self.view
+        angles, moments = getattr(v, "_qpos_bend", None), getattr(v, "_qfrc_bend", None)
+        if angles is None or moments is None or v.moments_follow_geometry or \
+                (self._stiffness_scale != 1.0 and not self._stiffness_in_model):
+            return None
+        return angles, moments, self._inv_moment
+
     def forget_moments(self) -> None:
         """The model's applied forces were cleared (mj_resetData): no moments to apply again."""
         self._moments = None

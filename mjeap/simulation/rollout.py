@@ -14,7 +14,8 @@ import numpy as np
 
 from .accuracy import target_for
 from ..engines import ENGINES, choose
-from ..engines.frame import (DEFAULT_SAMPLES, MAX_INITIAL_BEND, MAX_STEPS, RolloutResult, Samples, check_initial_curvature, check_sampling, check_work, one_voltage, sample_steps, to_waveform, voltage_steps)
+from .periodic import PeriodicStop, check_periodic_stop
+from ..engines.frame import (Decided, DEFAULT_SAMPLES, MAX_INITIAL_BEND, MAX_STEPS, RolloutResult, Samples, check_initial_curvature, check_sampling, check_work, one_voltage, sample_steps, to_waveform, voltage_steps)
 from ..errors import ParameterError, check_integer, check_positive
 from ..io.outputs import check_outputs, guarded, write_outputs
 from .scene import Scene
@@ -41,7 +42,8 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
             csv_path: Union[str, Path, None] = None, sample_interval: Optional[float] = None,
             progress: Optional[bool] = None, check_every: int = 100, controller=None,
             engine: str = "auto", max_steps: Optional[int] = None, accuracy: Optional[float] = None,
-            estimate_error: bool = False, error_model=None) -> RolloutResult:
+            estimate_error: bool = False, error_model=None,
+            stop_when_periodic: Optional[float] = None) -> RolloutResult:
     """Run ``scene`` driven by ``drive`` (name, instance or None for the actuator's own)
     with ``voltage`` (waveform text, :class:`Waveform` or callable v(t)) for ``duration`` s.
 
@@ -64,6 +66,12 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     ``error_model`` (with a target): the constants (a, b) of a similar question's run, its
     ``meta['accuracy']['error_model']``, in place of this run's pilots
     (:func:`mjeap.simulation.accuracy.run_at_accuracy`).
+
+    ``stop_when_periodic`` (relative tolerance, periodic waveforms): the run stops at the
+    first period boundary, from the second, where its last period repeats the one before
+    within the tolerance (tip curvature of its range, centreline of the length;
+    :mod:`mjeap.simulation.periodic`); ``meta['stopped_early']`` then says where and why and
+    the result ends there (at an accuracy target every run of the choice stops on its own).
     """
     from ..drives import make_drive
     from ..io import recording
@@ -78,15 +86,22 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
         if target is None:
             raise ParameterError("error_model", error_model, "None without an accuracy target (it chooses the model "
                                  "for one)")
+    if stop_when_periodic is not None:         # checked before any work, on the default sampling too
+        check_periodic_stop(stop_when_periodic, wave, duration,
+                            sample_interval or duration / DEFAULT_SAMPLES)
     if target is not None or estimate_error:
         return _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, csv_path, sample_interval,
-                                    check_every, controller, engine, max_steps, target, wave, error_model)
+                                    check_every, controller, engine, max_steps, target, wave, error_model,
+                                    stop_when_periodic)
     eng, engine_reason = choose(engine, scene, drv, controller)
     dt = scene.timestep
     v_steps = voltage_steps(wave, duration, dt, drv, max_steps)
     n_steps = len(v_steps)
     steps = sample_steps(n_steps, dt, sample_interval)
     samples = Samples(eng.part(scene, drv), len(steps))
+    if stop_when_periodic is not None:
+        tol, period = check_periodic_stop(stop_when_periodic, wave, duration, (steps[1] - steps[0]) * dt)
+        samples.stop = PeriodicStop(period, tol, scene.layout.length)
     meta = _meta(scene, drv, wave, duration, initial_curvature, n_steps, eng.name)
     meta["engine_reason"] = engine_reason
     if scene.choice.buckled:
@@ -101,6 +116,8 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     try:
         eng.run(scene, [drv], [v_steps], [initial_curvature], steps, [samples], progress=progress,
                 check_every=check_every, controller=controller, meta=meta)
+    except Decided as stop:     # a finished run that ends early: its result, not an error
+        meta["stopped_early"], meta["steps_run"] = stop.reason, stop.step
     except BaseException as e:  # record what was simulated, then re-raise
         error = e
         raise
@@ -119,7 +136,8 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
 
 
 def _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, csv_path, sample_interval,
-                         check_every, controller, engine, max_steps, target, wave, error_model=None) -> RolloutResult:
+                         check_every, controller, engine, max_steps, target, wave, error_model=None,
+                         stop_when_periodic=None) -> RolloutResult:
     """:func:`rollout` at an accuracy target (or, without one, with its error estimated): the
     runs of :mod:`mjeap.simulation.accuracy`, each with the drive ``drv`` names and its parameters;
     the outputs hold the chosen run, whose meta says how it was chosen."""
@@ -131,7 +149,8 @@ def _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, 
     def run(s, interval):
         return rollout(s, voltage, duration, drive=make_drive(drv.name, s, **params),
                        initial_curvature=initial_curvature, sample_interval=interval, progress=False,
-                       check_every=check_every, controller=controller, engine=engine, max_steps=max_steps)
+                       check_every=check_every, controller=controller, engine=engine, max_steps=max_steps,
+                       stop_when_periodic=stop_when_periodic)
 
     if target is None:
         chosen = scene
