@@ -89,3 +89,16 @@ def test_a_sweep_row_says_where_its_point_stopped(tmp_path):
               executor="serial", progress=False)
     (row,) = read_results(tmp_path / "s.csv")
     assert row["error"] == "" and row["stopped_early"].startswith("stopped at") and row["returns"] == "True"
+
+
+def test_the_threaded_engine_stops_too():
+    """An open-loop drive on mujoco.rollout (pvdf-60 driven at a third of its first
+    frequency): the stopped run is the full run's start, the scene left at the stop."""
+    s = Scene("pvdf-60", segments=6)
+    T = 3.0 / float(s.choice.first_frequency)
+    wave = f"sine:270V@{1.0 / T!r}Hz"
+    full, r = _pair(s, wave, 100 * T, 1e-2, sample_interval=T / 40, engine="threaded")
+    assert r.meta["engine"] == "threaded" and "stopped_early" in r.meta
+    n = len(r.time)
+    assert n < len(full.time) and np.array_equal(r.tip_curvature, full.tip_curvature[:n])
+    assert s.time == pytest.approx(r.time[-1], abs=s.timestep)
