@@ -27,3 +27,13 @@ def test_lsim_nonuniform_grid_falls_back_to_scipy():
     u = np.ones(4)
     with pytest.raises(ValueError):            # scipy refuses a non-uniform grid, and so do we
         lsim(SYSTEMS[0], u, t)
+
+
+@pytest.mark.parametrize("n", [2, 3])
+@pytest.mark.parametrize("interp", [True, False])
+def test_lsim_on_the_shortest_grids_equals_scipy(n, interp):
+    """A rollout sampled only at its start and end gives two samples: still scipy's answer."""
+    t, u = np.linspace(0.0, 0.05, n), np.linspace(1.0, 2.0, n)
+    for system in SYSTEMS:
+        ref = signal.lsim(system, u, t, interp=interp)[1]
+        assert np.max(np.abs(lsim(system, u, t, interp) - ref)) < 1e-12 * max(np.ptp(ref), 1.0)

@@ -11,7 +11,7 @@ import numpy as np
 from ..drives.base import NativeForm
 from .base import CONTROLLER_REASON, Engine
 from .frame import Decided
-from .threaded import LOADS, NATIVE_CONTROL, STATE, ahead_of_stop, raise_bad, roll
+from .threaded import LOADS, NATIVE_CONTROL, STATE, ahead_of_stop, raise_bad, roll, spare_datas
 
 
 def why_not(scene, drive, controller=None) -> Optional[str]:
@@ -93,7 +93,7 @@ def run_native(scene, native, drives: Sequence, v_steps: Sequence[np.ndarray], i
     try:
         try:
             final, bad = roll(m, state0, controls, len(template), spec, n, sample_steps, take, nthread,
-                              ahead_of_stop(samples, dt))
+                              ahead_of_stop(samples, dt), spare_datas(native, m))
         except Decided as stop:         # the run ends at the decision (Samples.stop)
             final, bad, n, decided = stop.state[None], None, stop.step, stop
         if bad is not None:

@@ -10,10 +10,22 @@ is not uniform goes to ``scipy.signal.lsim`` itself.
 """
 from __future__ import annotations
 
+import functools
+
 import numpy as np
 from scipy import signal
 
 __all__ = ["lsim"]
+
+
+@functools.lru_cache(maxsize=256)
+def _discrete(num: tuple, den: tuple, dt: float, method: str):
+    """(num, den) of the exact discretisation (scipy.signal.cont2discrete), cached: a drive's
+    reference is computed for every rollout, on the same few sample intervals."""
+    n, d, _ = signal.cont2discrete((np.array(num), np.array(den)), dt, method=method)
+    n, d = np.atleast_2d(n)[0], np.asarray(d, dtype=float)
+    n.flags.writeable = d.flags.writeable = False
+    return n, d
 
 
 def lsim(system: signal.TransferFunction, u, t, interp: bool = True) -> np.ndarray:
@@ -23,14 +35,14 @@ def lsim(system: signal.TransferFunction, u, t, interp: bool = True) -> np.ndarr
     u, t = np.asarray(u, dtype=float), np.asarray(t, dtype=float)
     if t.ndim != 1 or u.shape != t.shape:
         raise ValueError("t and u must be 1-D arrays of the same length")
-    if len(t) < 3:
+    if len(t) < 2:
         return signal.lsim(system, u, t, interp=interp)[1]
     dt = (t[-1] - t[0]) / (len(t) - 1)
     if not (dt > 0 and np.allclose(np.diff(t), dt, rtol=1e-9, atol=0.0)):
         return signal.lsim(system, u, t, interp=interp)[1]
     def filtered(method, x):
-        num, den, _ = signal.cont2discrete((system.num, system.den), dt, method=method)
-        return signal.lfilter(np.atleast_2d(num)[0], den, x)
+        num, den = _discrete(tuple(np.ravel(system.num)), tuple(np.ravel(system.den)), float(dt), method)
+        return signal.lfilter(num, den, x)
 
     if not interp:
         return filtered("zoh", u)
