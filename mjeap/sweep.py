@@ -177,6 +177,8 @@ def check_settings(points: Sequence[dict], base: Optional[dict]) -> None:
                                    [*PARAMETERS, "drive.NAME"])
     for p in points:
         full = {**PARAMETERS, **base, **p}
+        if full["stop_when_periodic"] not in (None, ""):      # refused once, not in every row
+            _check_stop(full)
         names = [k[6:] for k in full if k.startswith("drive.")]
         if not names:
             continue
@@ -189,6 +191,23 @@ def check_settings(points: Sequence[dict], base: Optional[dict]) -> None:
         for n in names:
             if n not in known:
                 raise UnknownNameError(f"{cls.name} drive parameter (drive.NAME)", n, known)
+
+
+def _wave_text(p: dict) -> str:
+    """The waveform text of a point's parameters (mjeap.drives.waveforms)."""
+    f, a = float(p["frequency"]), float(p["amplitude"])
+    return f"step:{a!r}V" if p["waveform"] == "step" else \
+        f"{p['waveform']}:{a!r}V@{f!r}Hz,offset={float(p['offset'])!r}V"
+
+
+def _check_stop(p: dict) -> None:
+    """A point's periodic stop, as its rollout will check it (mjeap.simulation.periodic)."""
+    from .drives.waveforms import parse_waveform
+    from .simulation.periodic import check_periodic_stop
+    f = float(p["frequency"])
+    duration = float(p["duration"]) if p["duration"] not in (None, "") else 2.0 / f
+    wave = parse_waveform(_wave_text(p))
+    check_periodic_stop(float(p["stop_when_periodic"]), wave, duration, min(duration / 5000, 0.125 / f))
 
 
 # ---------------------------------------------------------------- one point
@@ -224,9 +243,7 @@ def evaluate(point: dict, metrics: Sequence[str] = ("peak_to_peak", "returns"), 
                       accuracy=None if p["accuracy"] in (None, "") else float(p["accuracy"]))
         f = float(p["frequency"])
         duration = p["duration"] if p["duration"] is not None else 2.0 / f
-        kind = p["waveform"]
-        wave = f"step:{float(p['amplitude'])!r}V" if kind == "step" else \
-            f"{kind}:{float(p['amplitude'])!r}V@{f!r}Hz,offset={float(p['offset'])!r}V"
+        wave = _wave_text(p)
         drive_params = {k[6:]: v for k, v in p.items() if k.startswith("drive.")}
         rrd = None if rrd_dir is None else Path(rrd_dir) / f"point-{row['point_id']}.rrd"
         r = rollout(scene, wave, float(duration), drive_params=drive_params, initial_curvature=float(p["initial_curvature"]),

@@ -95,3 +95,60 @@ def test_direct_step_only_where_the_moments_are_the_joints_own(representation):
     """The cable's and the rod's bending is not a hinge joint's own dof and stiffness (their
     moments follow the geometry): no direct path there (the general one runs)."""
     assert Scene("pedot-micro", representation=representation, segments=8).part.direct_bending() is None
+
+
+def test_direct_step_follows_the_stiffness_a_native_run_leaves():
+    """A loop run, new hinge stiffness, a native run (which leaves the loop drive in its
+    state), then steps from Python (an environment's advance): the direct path must use the
+    new stiffness, as the general path does."""
+    import mujoco
+    from mjeap.engines.loop import advance
+    from mjeap.drives import make_drive
+    s = Scene("pedot-micro", segments=6)
+    d = make_drive("rc-relaxation", s)
+    rollout(s, "square:1V@0.5Hz", 0.5, drive=d, engine="loop", progress=False)
+    s.part.set_hinge_parameters(stiffness=2 * s.part.hinge_stiffness())
+    rollout(s, "square:1V@0.5Hz", 0.5, drive=d, engine="native", progress=False)
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    state = np.empty(mujoco.mj_stateSize(s.model, spec))
+    mujoco.mj_getState(s.model, s.data, state, spec)
+    saved_s, saved_k, direct = d._s.copy(), d._k.copy(), d._direct
+    assert direct is not None
+    out = []
+    for path in (direct, None):
+        mujoco.mj_setState(s.model, s.data, state, spec)
+        d._s[:], d._k = saved_s, saved_k.copy()
+        d._apply()
+        d._direct = path
+        advance(s.model, s.data, d, 1.0, s.timestep, 2000)
+        s.update_kinematics()
+        out.append(s.part.tip_curvature())
+    assert out[0] == pytest.approx(out[1], rel=1e-9)
+
+
+def test_signals_after_a_rebind_are_the_general_paths():
+    """Direct steps, then the scene's data replaced (the general path takes over): the
+    relaxation moment must come from the general path, not from the old data's forces."""
+    import mujoco
+    from mjeap.drives import make_drive
+    s = Scene("pedot-micro", segments=8)
+
+    def go(rebind):
+        s.reset()
+        d = make_drive("rc-relaxation", s)
+        d.reset(0.0)
+        for _ in range(50):
+            d.step(1.0, s.timestep)
+            mujoco.mj_step(s.model, s.data)
+        if rebind:
+            new = mujoco.MjData(s.model)
+            mujoco.mj_copyData(new, s.model, s.data)
+            s.data = new
+        for _ in range(50):
+            d.step(1.0, s.timestep)
+            mujoco.mj_step(s.model, s.data)
+        return d.signals()
+
+    a, b = go(False), go(True)
+    for k in a:
+        assert b[k] == pytest.approx(a[k], rel=1e-6, abs=1e-18), k

@@ -85,7 +85,12 @@ class RCRelaxationDrive(NativeForm, Drive):
         self._v = 0.0
         self._k = sc.hinge_stiffness()
         self._apply()
-        self._stale = False
+        self._bind_direct()
+
+    def _bind_direct(self):
+        """The direct path's views and constants for the present part, data and stiffness
+        (Part.direct_bending), or None; after :meth:`_apply` (the moments it wrote are current)."""
+        sc = self.part
         d = sc.direct_bending()
         if d is not None:       # moments in internal units straight into qfrc_applied
             theta, qfrc, scale = d
@@ -100,6 +105,7 @@ class RCRelaxationDrive(NativeForm, Drive):
         np.multiply(self._k, self._r, out=self._m_relax)
         np.add(self._m_relax, self._m_drive, out=self._m_total)
         self.part.set_internal_moments(self._m_total)
+        self._stale = False
 
     def step(self, voltage: float, dt: float) -> None:
         self._v = voltage
@@ -222,6 +228,7 @@ class RCRelaxationDrive(NativeForm, Drive):
         self._k = self.part.hinge_stiffness()
         np.divide(self._m_relax, self._k, out=self._r)
         self._apply()
+        self._bind_direct()          # the stiffness may have changed since the last reset
 
     def closed_loop_reason(self):
         return "the back-relaxation acts on every moment the beam carries, so the moments follow the hinge angles"

@@ -12,7 +12,7 @@ from typing import List, Optional, Sequence, Union
 
 import numpy as np
 
-from .accuracy import target_for
+from .accuracy import GRID_SAMPLES, target_for
 from ..engines import ENGINES, choose
 from .periodic import PeriodicStop, check_periodic_stop
 from ..engines.frame import (Decided, DEFAULT_SAMPLES, MAX_INITIAL_BEND, MAX_STEPS, RolloutResult, Samples, check_initial_curvature, check_sampling, check_work, one_voltage, sample_steps, to_waveform, voltage_steps)
@@ -86,9 +86,10 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
         if target is None:
             raise ParameterError("error_model", error_model, "None without an accuracy target (it chooses the model "
                                  "for one)")
-    if stop_when_periodic is not None:         # checked before any work, on the default sampling too
-        check_periodic_stop(stop_when_periodic, wave, duration,
-                            sample_interval or duration / DEFAULT_SAMPLES)
+    if stop_when_periodic is not None:         # checked before any work, on the sampling the run will have
+        at_grid = target is not None or estimate_error
+        check_periodic_stop(stop_when_periodic, wave, duration, sample_interval or
+                            duration / (GRID_SAMPLES if at_grid else DEFAULT_SAMPLES))
     if target is not None or estimate_error:
         return _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, csv_path, sample_interval,
                                     check_every, controller, engine, max_steps, target, wave, error_model,
@@ -147,10 +148,14 @@ def _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, 
     params = dict(drv.params)
 
     def run(s, interval):
+        # each run stops on its own where its sampling allows (the estimate compares the runs
+        # over the instants they share); a companion sampled coarser runs to the end
+        stop = stop_when_periodic if stop_when_periodic is not None and \
+            (interval or duration / DEFAULT_SAMPLES) <= 0.125 / wave.frequency else None
         return rollout(s, voltage, duration, drive=make_drive(drv.name, s, **params),
                        initial_curvature=initial_curvature, sample_interval=interval, progress=False,
                        check_every=check_every, controller=controller, engine=engine, max_steps=max_steps,
-                       stop_when_periodic=stop_when_periodic)
+                       stop_when_periodic=stop)
 
     if target is None:
         chosen = scene
