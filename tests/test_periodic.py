@@ -133,3 +133,22 @@ def test_a_sweep_refuses_a_stop_its_points_cannot_make_once_before_any_point(tmp
     with pytest.raises(ParameterError, match="stop_when_periodic"):       # duration 2 / f: two periods
         run_sweep([dict(amplitude=1.0)], tmp_path / "s.csv", base=base, executor="serial", progress=False)
     assert not (tmp_path / "s.csv").exists()
+
+
+def test_the_stop_reads_the_tip_not_the_payload_beyond_it():
+    """A store whose tip moves periodically while its payload point creeps (slowly, within the
+    shape tolerance, but its arc curvature far from periodic): the tip decides, so it stops."""
+    from types import SimpleNamespace
+    from mjeap.engines.frame import Decided
+    from mjeap.simulation.periodic import PeriodicStop
+    N, L, T, h = 4, 6e-3, 1.0, 1.0 / 40
+    t = np.arange(0, 5 * T + h / 2, h)
+    pts = np.zeros((len(t), N + 3, 3))
+    pts[:, 1:N + 1, 0] = np.linspace(0, L, N + 2)[1:-1]
+    pts[:, N + 1, 0], pts[:, N + 1, 1] = L, 1e-3 * np.sin(2 * np.pi * t / T)     # the tip: periodic
+    pts[:, N + 2, 0], pts[:, N + 2, 1] = 1e-3, 1e-5 * t / T                        # the payload: creeping
+    part = SimpleNamespace(layout=SimpleNamespace(segments=N), timestep=h)
+    stop = PeriodicStop(T, 0.1, L)
+    with pytest.raises(Decided):
+        for n in range(2, len(t) + 1):
+            stop(SimpleNamespace(n=n, t=t, part=part, clamp_frame=lambda idx: (pts[idx], None)))

@@ -70,7 +70,9 @@ class PeriodicStop:
         """(decided, rho, tail) of one quantity's period-to-period differences; ``floor``:
         the difference the samples cannot resolve (:meth:`_floor`)."""
         tol = self.tolerance
-        if max(d_last, d_before) <= max(2.0 * floor, 1e-3 * tol):   # settled, as far as the samples tell:
+        if max(d_last, d_before) <= 1e-3 * tol:     # repeats to far below the tolerance
+            return True, 0.0, 0.0
+        if max(d_last, d_before) <= 2.0 * floor:    # settled, as far as the samples tell:
             return d_last <= tol and 2.0 * floor <= tol, 0.0, 0.0    # a stop only if they resolve the tolerance
         rho = d_last / d_before if d_before > 0 else np.inf
         tail = d_last * rho / (1.0 - rho) if rho < 1 else np.inf
