@@ -200,14 +200,17 @@ def _wave_text(p: dict) -> str:
         f"{p['waveform']}:{a!r}V@{f!r}Hz,offset={float(p['offset'])!r}V"
 
 
+def _duration(p: dict) -> float:
+    """A point's duration (s): its own, else two drive periods."""
+    return float(p["duration"]) if p["duration"] not in (None, "") else 2.0 / float(p["frequency"])
+
+
 def _check_stop(p: dict) -> None:
-    """A point's periodic stop, as its rollout will check it (mjeap.simulation.periodic)."""
+    """A point's periodic stop, as its rollout will check it (mjeap.simulation.rollout.check_stop)."""
     from .drives.waveforms import parse_waveform
-    from .simulation.periodic import check_periodic_stop
-    f = float(p["frequency"])
-    duration = float(p["duration"]) if p["duration"] not in (None, "") else 2.0 / f
-    wave = parse_waveform(_wave_text(p))
-    check_periodic_stop(float(p["stop_when_periodic"]), wave, duration, min(duration / 5000, 0.125 / f))
+    from .simulation.rollout import check_stop
+    check_stop(float(p["stop_when_periodic"]), parse_waveform(_wave_text(p)), _duration(p),
+               at_accuracy=p["accuracy"] not in (None, ""))
 
 
 # ---------------------------------------------------------------- one point
@@ -241,12 +244,10 @@ def evaluate(point: dict, metrics: Sequence[str] = ("peak_to_peak", "returns"), 
         scene = Scene(p["actuator"], representation=p["representation"], segments=int(p["segments"]),
                       orientation=p["orientation"], payload=payload, damping_ratio=p["damping_ratio"],
                       accuracy=None if p["accuracy"] in (None, "") else float(p["accuracy"]))
-        f = float(p["frequency"])
-        duration = p["duration"] if p["duration"] is not None else 2.0 / f
         wave = _wave_text(p)
         drive_params = {k[6:]: v for k, v in p.items() if k.startswith("drive.")}
         rrd = None if rrd_dir is None else Path(rrd_dir) / f"point-{row['point_id']}.rrd"
-        r = rollout(scene, wave, float(duration), drive_params=drive_params, initial_curvature=float(p["initial_curvature"]),
+        r = rollout(scene, wave, _duration(p), drive_params=drive_params, initial_curvature=float(p["initial_curvature"]),
                     progress=False, rrd=rrd, engine=p["engine"],
                     error_model=error_model if scene.accuracy is not None else None,
                     stop_when_periodic=None if p["stop_when_periodic"] in (None, "") else

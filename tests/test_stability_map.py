@@ -56,3 +56,18 @@ def test_script_writes_report_image_and_recording(tmp_path):
     # laid out: the report beside the figure (axes and units), no bare 2D scatter
     assert {(v["kind"], v["origin"]) for v in read_blueprint(out / "stability_map.rrd")} == \
         {("TextDocument", "/report"), ("2D", "/figure")}
+
+
+def test_script_stops_points_once_periodic_and_refuses_a_stop_its_periods_cannot_make(tmp_path):
+    """--stop-when-periodic needs four periods: with the map's three it is refused before any
+    point (no results file); with six, a light payload's point stops and its row says where."""
+    out = tmp_path / "map"
+    cmd = [sys.executable, str(ROOT / "scripts" / "stability_map.py"), "--masses", "2", "--amplitudes", "1",
+           "--workers", "1", "--executor", "serial", "--stop-when-periodic", "0.01"]
+    bad = subprocess.run(cmd + ["--out", str(tmp_path / "bad")], cwd=ROOT, capture_output=True, text=True)
+    assert bad.returncode != 0 and "stop_when_periodic" in bad.stderr and "4 periods" in bad.stderr
+    assert not (tmp_path / "bad" / "results.csv").exists()
+    subprocess.run(cmd + ["--out", str(out), "--periods", "6"], check=True, cwd=ROOT, capture_output=True, text=True)
+    (row,) = read_results(out / "results.csv")
+    assert row["stopped_early"].startswith("stopped at")
+    assert "of 6 periods" in (out / "report.md").read_text()

@@ -20,11 +20,13 @@ from ..engines.frame import Decided
 from ..errors import ParameterError, check_range
 from ..model.analytical import arc_curvature
 
-__all__ = ["Decided", "PeriodicStop", "check_periodic_stop"]
+__all__ = ["Decided", "PeriodicStop", "check_periodic_stop", "PERIODIC_KINDS", "MIN_SAMPLES_PER_PERIOD"]
 
 
 #: the waveforms that repeat with their frequency (from t = 0, without a delay)
 PERIODIC_KINDS = ("sine", "square", "triangle")
+#: a run that may stop is sampled at least this often a period
+MIN_SAMPLES_PER_PERIOD = 8
 
 
 def check_periodic_stop(tolerance, wave, duration: float, sample_interval: float):
@@ -43,9 +45,9 @@ def check_periodic_stop(tolerance, wave, duration: float, sample_interval: float
     if duration < 4 * period:
         raise ParameterError("stop_when_periodic", tolerance, f"None for a run of {duration:g} s: it can stop only "
                              f"after three periods and before its end (at least 4 periods, {4 * period:g} s)")
-    if sample_interval > period / 8:
-        raise ParameterError("sample_interval", sample_interval, f"at most {period / 8:g} s (8 samples a period) "
-                             "with stop_when_periodic")
+    if sample_interval > period / MIN_SAMPLES_PER_PERIOD:
+        raise ParameterError("sample_interval", sample_interval, f"at most {period / MIN_SAMPLES_PER_PERIOD:g} s "
+                             f"({MIN_SAMPLES_PER_PERIOD} samples a period) with stop_when_periodic")
     return tol, period
 
 
@@ -64,7 +66,6 @@ class PeriodicStop:
     def __init__(self, period: float, tolerance: float, length: float):
         self.period, self.tolerance, self.length = float(period), float(tolerance), float(length)
         self._next = 3 * self.period                # first boundary with three periods behind it
-        self.checked = 0                            # boundaries compared
 
     def _decided(self, d_last: float, d_before: float, floor: float):
         """(decided, rho, tail) of one quantity's period-to-period differences; ``floor``:
@@ -96,7 +97,6 @@ class PeriodicStop:
         if t[-1] < self._next - eps:
             return
         self._next = (int(round(t[-1] / T)) + 1) * T
-        self.checked += 1
         use = t >= t[-1] - 3 * T - 1.5 * (t[-1] - t[-2])          # three periods and a sample before them
         pts, _ = samples.clamp_frame(np.nonzero(use)[0])
         tu = t[use]

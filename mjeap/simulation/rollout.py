@@ -14,7 +14,7 @@ import numpy as np
 
 from .accuracy import GRID_SAMPLES, target_for
 from ..engines import ENGINES, choose
-from .periodic import PeriodicStop, check_periodic_stop
+from .periodic import MIN_SAMPLES_PER_PERIOD, PeriodicStop, check_periodic_stop
 from ..engines.frame import (Decided, DEFAULT_SAMPLES, MAX_INITIAL_BEND, MAX_STEPS, RolloutResult, Samples, check_initial_curvature, check_sampling, check_work, one_voltage, sample_steps, to_waveform, voltage_steps)
 from ..errors import ParameterError, check_integer, check_positive
 from ..io.outputs import check_outputs, guarded, write_outputs
@@ -24,6 +24,15 @@ from ..drives.waveforms import Waveform
 __all__ = ["rollout", "rollout_batch", "free_vibration", "RolloutResult", "ENGINES", "MAX_STEPS", "DEFAULT_SAMPLES",
            "MAX_INITIAL_BEND", "check_work", "check_sampling", "check_outputs", "write_outputs", "one_voltage",
            "check_initial_curvature"]
+
+
+def check_stop(stop_when_periodic, wave, duration: float, sample_interval: Optional[float] = None,
+               at_accuracy: bool = False):
+    """:func:`mjeap.simulation.periodic.check_periodic_stop` on the sampling the rollout will
+    have (``sample_interval``, else its default: DEFAULT_SAMPLES over the run, GRID_SAMPLES at
+    an accuracy target or with an error estimate): (tolerance, period s)."""
+    return check_periodic_stop(stop_when_periodic, wave, duration, sample_interval or
+                               duration / (GRID_SAMPLES if at_accuracy else DEFAULT_SAMPLES))
 
 
 def _meta(scene, drv, wave, duration, initial_curvature, n_steps, engine) -> dict:
@@ -68,9 +77,9 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     (:func:`mjeap.simulation.accuracy.run_at_accuracy`).
 
     ``stop_when_periodic`` (relative tolerance, periodic waveforms): the run stops at the
-    first period boundary, from the second, where its last period repeats the one before
-    within the tolerance (tip curvature of its range, centreline of the length;
-    :mod:`mjeap.simulation.periodic`); ``meta['stopped_early']`` then says where and why and
+    first period boundary, from the third, where its last period repeats the one before
+    within the tolerance and the shrinking change still to come stays within it (tip
+    curvature of its range, centreline of the length; :mod:`mjeap.simulation.periodic`); ``meta['stopped_early']`` then says where and why and
     the result ends there (at an accuracy target every run of the choice stops on its own).
     """
     from ..drives import make_drive
@@ -87,9 +96,8 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
             raise ParameterError("error_model", error_model, "None without an accuracy target (it chooses the model "
                                  "for one)")
     if stop_when_periodic is not None:         # checked before any work, on the sampling the run will have
-        at_grid = target is not None or estimate_error
-        check_periodic_stop(stop_when_periodic, wave, duration, sample_interval or
-                            duration / (GRID_SAMPLES if at_grid else DEFAULT_SAMPLES))
+        stop_tol, period = check_stop(stop_when_periodic, wave, duration, sample_interval,
+                                      target is not None or estimate_error)
     if target is not None or estimate_error:
         return _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, csv_path, sample_interval,
                                     check_every, controller, engine, max_steps, target, wave, error_model,
@@ -101,8 +109,7 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     steps = sample_steps(n_steps, dt, sample_interval)
     samples = Samples(eng.part(scene, drv), len(steps))
     if stop_when_periodic is not None:
-        tol, period = check_periodic_stop(stop_when_periodic, wave, duration, (steps[1] - steps[0]) * dt)
-        samples.stop = PeriodicStop(period, tol, scene.layout.length)
+        samples.stop = PeriodicStop(period, stop_tol, scene.layout.length)
     meta = _meta(scene, drv, wave, duration, initial_curvature, n_steps, eng.name)
     meta["engine_reason"] = engine_reason
     if scene.choice.buckled:
@@ -151,7 +158,7 @@ def _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, 
         # each run stops on its own where its sampling allows (the estimate compares the runs
         # over the instants they share); a companion sampled coarser runs to the end
         stop = stop_when_periodic if stop_when_periodic is not None and \
-            (interval or duration / DEFAULT_SAMPLES) <= 0.125 / wave.frequency else None
+            (interval or duration / DEFAULT_SAMPLES) * wave.frequency <= 1.0 / MIN_SAMPLES_PER_PERIOD else None
         return rollout(s, voltage, duration, drive=make_drive(drv.name, s, **params),
                        initial_curvature=initial_curvature, sample_interval=interval, progress=False,
                        check_every=check_every, controller=controller, engine=engine, max_steps=max_steps,
