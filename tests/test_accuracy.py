@@ -218,3 +218,30 @@ def test_the_claim_with_shared_priors_on_seeded_cases():
     detail = "\n".join(f"{r['case']}: true {r['true_error']:.3g}, estimate {r['estimated_error']:.3g}" for r in rows)
     assert s["below_target"] == 1.0, detail
     assert s["estimate_over_true_range"][0] >= 1 / 3, detail
+
+
+def test_a_target_keeps_the_scenes_tip_loads_and_meets_the_elastica():
+    """The models a target runs are variants of the scene: they carry its tip force (they
+    once ran unloaded, "error 0", 4 segments). Reference: the elastica of a dead tip force
+    P L^2 / EI = 1 (mjeap.analytical, a BVP), settled (first-mode damping ratio 0.7)."""
+    from mjeap import analytical as an
+    s = Scene("pedot-micro", gravity=False, damping_ratio=0.7)
+    L, EI = s.length, float(s.flexural_rigidity(0.0))
+    s.set_tip_force(EI / L**2)
+    ref = an.elastica_tip_force(EI / L**2, L, EI).tip
+    r = rollout(s, "step:0V", 0.05, drive="none", accuracy=1e-2)
+    a = r.meta["accuracy"]
+    assert a["met"] and 0 < a["error_model"]["spatial_a"]
+    assert np.all(r.tip_position[-1, :2] > 0)
+    # the tip within 1 % of the deflection (the chosen model's own error, not a tuned one)
+    assert abs(r.tip_position[-1, 1] / ref[1] - 1) < 1e-2, (r.tip_position[-1], ref, a["model"])
+    v = s.variant(8, s.timestep, "implicitfast")
+    np.testing.assert_allclose(v.part.tip_loads()[0], [0.0, EI / L**2, 0.0], rtol=1e-12, atol=1e-20)
+
+
+def test_hinge_parameters_set_by_hand_refuse_a_target_or_an_estimate():
+    s = Scene("pedot-micro", **FAST)
+    s.set_hinge_parameters(stiffness=s.layout.hinge_stiffness * 1.1)
+    for kw in (dict(accuracy=1e-2), dict(estimate_error=True)):
+        with pytest.raises(ParameterError, match="set_hinge_parameters"):
+            rollout(s, "sine:1V@5Hz", 0.1, **kw)

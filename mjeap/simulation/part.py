@@ -226,6 +226,11 @@ class ActuatorPart:
         self._tip_moment = m / self.units.moment
         self.apply_loads()
 
+    def tip_loads(self):
+        """The tip loads as set: force (N, clamp frame: axial, transverse, out-of-plane) and
+        moment (N m)."""
+        return (self.rotation.T @ self._tip_force_world * self.units.force, self._tip_moment * self.units.moment)
+
     def has_tip_load(self) -> bool:
         return bool(self._tip_force_world.any() or self._tip_moment)
 
