@@ -245,3 +245,6 @@ def test_hinge_parameters_set_by_hand_refuse_a_target_or_an_estimate():
     for kw in (dict(accuracy=1e-2), dict(estimate_error=True)):
         with pytest.raises(ParameterError, match="set_hinge_parameters"):
             rollout(s, "sine:1V@5Hz", 0.1, **kw)
+        assert s.time == 0.0                       # refused before any run
+    with pytest.raises(ParameterError, match="set_hinge_parameters"):
+        rollout_batch(s, ["sine:1V@5Hz"], 0.1, accuracy=1e-2)

@@ -256,3 +256,21 @@ def test_a_system_refuses_an_estimate_beside_a_controller():
     s = System(spec, [attach(spec, "pedot-micro", site="a", prefix="d", contact=False)])
     with pytest.raises(ParameterError, match="estimate_error"):
         s.rollout(None, 0.01, controller=lambda t, sy: [0.5], estimate_error=True)
+
+
+def test_the_half_step_companion_carries_the_tip_loads_and_hand_set_hinges_are_refused():
+    """The estimate's companion (System.half_step) is the same system: its actuators carry
+    the tip loads set on the system's parts (they once ran unloaded). Hinge parameters set
+    by hand are refused up front, before the run."""
+    spec = host('<site name="a"/>')
+    s = System(spec, [attach(spec, "pedot-micro", site="a", prefix="d", contact=False)])
+    s.part("d").set_tip_force(1e-6)
+    s.part("d").set_tip_moment(2e-9)
+    half = s.half_step()
+    f, m = half.part("d").tip_loads()
+    np.testing.assert_allclose(f, [0.0, 1e-6, 0.0], atol=1e-18)
+    assert m == pytest.approx(2e-9)
+    s.part("d").set_hinge_parameters(stiffness=s.part("d").layout.hinge_stiffness)
+    with pytest.raises(ParameterError, match="set_hinge_parameters"):
+        s.rollout({"d": "step:0.5V"}, 0.01, estimate_error=True)
+    assert s.time == 0.0

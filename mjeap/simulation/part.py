@@ -231,6 +231,27 @@ class ActuatorPart:
         moment (N m)."""
         return (self.rotation.T @ self._tip_force_world * self.units.force, self._tip_moment * self.units.moment)
 
+    def check_derivable(self) -> None:
+        """Refuse to derive models from this one (other segments or another step: a model
+        chosen for an accuracy target, an error estimate's companions) when its hinges were
+        given their own values (:meth:`set_hinge_parameters`): they belong to these hinges."""
+        if self.revision:
+            raise ParameterError("scene", "hinge parameters set by set_hinge_parameters",
+                                 "a beam whose hinges keep the catalog's stiffness and damping, for a rollout that "
+                                 "chooses its model (accuracy=) or estimates its error (estimate_error=)",
+                                 "the values belong to this model's hinges; a model of other segments or another "
+                                 "step cannot carry them")
+
+    def carry_loads(self, other: "ActuatorPart") -> None:
+        """Set this part's tip loads on ``other``, this actuator in a model derived from this
+        one (see :meth:`check_derivable`, which this calls first)."""
+        self.check_derivable()
+        force, moment = self.tip_loads()
+        if force.any():
+            other.set_tip_force(force)
+        if moment:
+            other.set_tip_moment(moment)
+
     def has_tip_load(self) -> bool:
         return bool(self._tip_force_world.any() or self._tip_moment)
 

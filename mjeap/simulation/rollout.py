@@ -99,6 +99,7 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
         stop_tol, period = check_stop(stop_when_periodic, wave, duration, sample_interval,
                                       target is not None or estimate_error)
     if target is not None or estimate_error:
+        scene.part.check_derivable()
         return _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, csv_path, sample_interval,
                                     check_every, controller, engine, max_steps, target, wave, error_model,
                                     stop_when_periodic)
@@ -227,6 +228,7 @@ def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable
     target = target_for(scene, accuracy)
     if target is not None:
         from .accuracy import run_at_accuracy
+        scene.part.check_derivable()
         waves = [to_waveform(v, duration) for v in voltages]
         fastest = max(waves, key=lambda w: getattr(w, "max_frequency", 0.0) or 0.0)
         make_drive(drive, scene, **(drive_params or {}))          # the drive's parameters, checked first

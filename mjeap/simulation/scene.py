@@ -318,22 +318,12 @@ class Scene:
         an error the target's estimate accounts for. The tip loads set on this scene
         (:meth:`set_tip_force`, :meth:`set_tip_moment`) act on the variant too; hinge
         parameters set by hand belong to this model's hinges and are refused."""
-        part = self.part
-        if part.revision:
-            raise ParameterError("scene", "hinge parameters set by set_hinge_parameters",
-                                 "a scene whose hinges keep the catalog's stiffness and damping, for a rollout "
-                                 "that chooses its model (accuracy=) or estimates its error (estimate_error=)",
-                                 "the values belong to this model's hinges; a model of other segments or "
-                                 "another step cannot carry them")
+        self.part.check_derivable()
         s = Scene.__new__(Scene)
         s.chosen_model = True
         Scene.__init__(s, **{**self._arguments, "segments": segments, "timestep": timestep,
                              "integrator": integrator})
-        force, moment = part.tip_loads()
-        if force.any():
-            s.set_tip_force(force)
-        if moment:
-            s.set_tip_moment(moment)
+        self.part.carry_loads(s.part)
         return s
 
     @property

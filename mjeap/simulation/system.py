@@ -625,6 +625,9 @@ class System:
             raise ParameterError("estimate_error", estimate_error, "False with a controller or on_sample: the "
                                  "companion run at half the step would call them again (they may keep state or "
                                  "move the model)")
+        if estimate_error:
+            for p in self.parts:
+                p.check_derivable()
         eng, engine_reason = choose_system(engine, self, controller, on_sample)
         if controller is not None:
             if voltages is not None and any(v is not None for v in self._per_actuator("voltages", voltages)):
@@ -726,6 +729,12 @@ class System:
 
     def half_step(self) -> "System":
         """This system at half its timestep: a copy of its spec with the same actuators,
-        integrator and contact parameters (contact's time constant, in steps, halves with it)."""
-        return System(self.spec.copy(), self.actuators, self.units, timestep=self.timestep / 2,
+        integrator and contact parameters (contact's time constant, in steps, halves with it),
+        and the tip loads set on its actuators."""
+        for p in self.parts:
+            p.check_derivable()
+        half = System(self.spec.copy(), self.actuators, self.units, timestep=self.timestep / 2,
                       integrator=self.integrator, contact=self.contact)
+        for p, q in zip(self.parts, half.parts):
+            p.carry_loads(q)
+        return half
