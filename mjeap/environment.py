@@ -94,6 +94,7 @@ class CurvatureTrackingTask(base.Task):
     # -- episode -----------------------------------------------------------------------
     def initialize_episode(self, physics: BeamPhysics) -> None:
         sc = physics.scene
+        sc.part.after_data_reset()          # Physics.reset cleared xfrc_applied: the tip loads persist
         check_curvature_range(self.initial_curvature_range, sc.layout.length)
         self.episode = draw_episode(sc, self.random, self.payload_mass_range, self.initial_curvature_range)
         kappa0 = self.episode["initial_curvature_per_m"]

@@ -89,3 +89,16 @@ def test_episode_recording(tmp_path):
 
 if __name__ == "__main__":
     absltest.main()
+
+
+def test_an_episode_reset_keeps_the_tip_loads():
+    """Physics.reset clears xfrc_applied; the scene's tip loads persist across episodes (as
+    Scene.reset keeps them), so the next episode is the same question."""
+    env = short_env(time_limit=0.01)
+    sc = env.physics.scene
+    sc.set_tip_force(1e-7)
+    tip = sc.part.tip_load_id
+    before = env.physics.data.xfrc_applied[tip].copy()
+    assert before.any()
+    env.reset()
+    np.testing.assert_array_equal(env.physics.data.xfrc_applied[tip], before)

@@ -108,3 +108,16 @@ def test_cli_identify_step(tmp_path, capsys):
     bad = write(tmp_path, "time,x\n1,2\n", "bad.csv")
     assert main(["identify", "step", str(bad), "--voltage", "3"]) == 2
     assert "tip_curvature" in capsys.readouterr().err
+
+
+def test_bad_hinge_parameters_change_nothing():
+    """Refused values leave the hinges, and the scene's derivability, as they were."""
+    from mjeap import Scene
+    from mjeap.errors import ParameterError
+    s = Scene("pedot-micro", segments=6)
+    k0 = s.part.hinge_stiffness().copy()
+    for kw in (dict(stiffness=-1.0), dict(stiffness=2 * k0, damping=-1.0)):
+        with pytest.raises(ParameterError):
+            s.set_hinge_parameters(**kw)
+        np.testing.assert_array_equal(s.part.hinge_stiffness(), k0)
+        assert s.part.revision == 0

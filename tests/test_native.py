@@ -159,3 +159,24 @@ def test_tip_loads_ride_along_in_the_native_engine():
     b = rollout(s, "step:0.5V", 0.05, engine="native")
     assert b.meta["engine"] == "native" and np.ptp(a.tip_curvature) > 0
     assert np.max(np.abs(a.tip_curvature - b.tip_curvature)) <= 1e-3 * np.ptp(a.tip_curvature)
+
+
+def test_the_native_form_follows_hand_set_hinges_and_not_a_leftover_stiffness_scale():
+    """The native model starts from the hinges as built or identified: seed 000's drive once
+    rebuilt its springs and Maxwell arms from the catalog (an identified stiffness did nothing
+    on the native engine), and a stiffness scale a loop run left behind (seed 001's
+    stiffness table) was compiled into the cached native model. Reference: the loop engine,
+    the Python drive on the scene's own model."""
+    from mjeap import Scene, rollout
+    s = Scene("pedot-micro", segments=8)
+    s.set_hinge_parameters(stiffness=2 * s.layout.hinge_stiffness)
+    loop = rollout(s, "step:1V", 0.5, engine="loop")
+    native = rollout(s, "step:1V", 0.5, engine="native")
+    swing = np.ptp(loop.tip_curvature)
+    assert np.max(np.abs(native.tip_curvature - loop.tip_curvature)) < 1e-3 * swing
+    p = Scene("ppy-trilayer", segments=8)
+    rollout(p, "step:1V", 0.2, engine="loop", drive_params={"stiffness_table": [(0, 1), (1, 2)]})
+    loop = rollout(p, "step:1V", 0.2, engine="loop")
+    native = rollout(p, "step:1V", 0.2, engine="native")
+    swing = np.ptp(loop.tip_curvature)
+    assert np.max(np.abs(native.tip_curvature - loop.tip_curvature)) < 1e-3 * swing

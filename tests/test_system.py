@@ -274,3 +274,28 @@ def test_the_half_step_companion_carries_the_tip_loads_and_hand_set_hinges_are_r
     with pytest.raises(ParameterError, match="set_hinge_parameters"):
         s.rollout({"d": "step:0.5V"}, 0.01, estimate_error=True)
     assert s.time == 0.0
+
+
+ARM = ('<body name="arm"><joint name="swing" type="hinge" axis="0 0 1"/>'
+       '<geom type="sphere" size="0.1" mass="1" contype="0" conaffinity="0"/>'
+       '<site name="mount" pos="2 0 0"/></body>')
+
+
+def test_on_a_moving_clamp_the_companion_and_a_reset_keep_the_tip_loads_in_the_world():
+    """A clamp on a swinging arm: the force set stays the force in the world after the arm
+    turns (the half-step companion starts from qpos0 and must not re-express it in its own
+    clamp frame), and a reset re-applies the moment about the hinge axis (it had been written
+    before the clamp's frame was known, as zero)."""
+    spec = host(ARM, gravity="0 0 0")
+    s = System(spec, [attach(spec, "pedot-micro", site="mount", prefix="d", contact=False)])
+    p = s.part("d")
+    p.set_tip_force(1e-6)
+    p.set_tip_moment(2e-9)
+    world = s.data.xfrc_applied[p.tip_load_id].copy()
+    assert world[3:].any()
+    s.data.qpos[s.model.joint("swing").qposadr[0]] = 0.7
+    mujoco.mj_forward(s.model, s.data)
+    half = s.half_step()
+    np.testing.assert_allclose(half.data.xfrc_applied[half.part("d").tip_load_id], world, rtol=1e-12, atol=0)
+    s.reset()
+    np.testing.assert_allclose(s.data.xfrc_applied[p.tip_load_id], world, rtol=1e-12, atol=0)

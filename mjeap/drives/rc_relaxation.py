@@ -159,7 +159,7 @@ class RCRelaxationDrive(NativeForm, Drive):
         z, pm, pe = self._internal_rates()
         native.add_bending_tendon(spec, joints, np.ones(len(joints)))
         native.add_drive_actuator(spec, self.gamma / u.moment, self.voltage_range(), time_constant=1.0 / pe)
-        k = self.scene.layout.hinge_stiffness / u.rotational_stiffness
+        k, _ = self.scene.part.built_hinge_parameters()      # as built or identified (internal)
         relax = native.add_maxwell_arms(spec, joints, parent, k, z, pm, self.scene.timestep / u.time,
                                         float(self.scene.layout.link_mass.min() / u.mass))
         return native.NativeHandles(relaxation_joints=relax)

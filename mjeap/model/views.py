@@ -99,6 +99,10 @@ class BeamView:
         """Scale the beam's damping to ``factor`` x its value as built."""
         raise NotImplementedError
 
+    def built_damping(self) -> np.ndarray:
+        """Every hinge's bending damping as built (or set), unscaled (internal)."""
+        raise NotImplementedError
+
     def set_damping(self, b: np.ndarray) -> None:
         """Set every hinge's viscous damping (internal), replacing the built value."""
         raise NotImplementedError
@@ -166,6 +170,9 @@ class JointView(BeamView):
 
     def damping(self):
         return self.model.dof_damping[self.bend_dof]
+
+    def built_damping(self):
+        return self._d0[self.bend_dof].copy()
 
     def scale_damping(self, factor):
         if self._dof_damping_bend is not None:

@@ -24,10 +24,12 @@ class NativeModel:
         if why is not None:
             raise ParameterError("engine", "native", f"'loop' or 'auto' for this run: {why}")
         spec = scene.spec.copy()
-        m0 = scene.model
-        for name, j in zip(scene.handles.joints, scene.part.joint_ids):   # present values (identify may set them)
-            spec.joint(name).stiffness = [float(m0.jnt_stiffness[j]), 0.0, 0.0]
-            spec.joint(name).damping = [float(m0.dof_damping[m0.jnt_dofadr[j]]), 0.0, 0.0]
+        # the hinges as built or set by hand (identify sets them), without a drive's present
+        # stiffness scale (a run's leftover would otherwise be compiled in and cached)
+        k, b = scene.part.built_hinge_parameters()
+        for name, kj, bj in zip(scene.handles.joints, k, b):
+            spec.joint(name).stiffness = [float(kj), 0.0, 0.0]
+            spec.joint(name).damping = [float(bj), 0.0, 0.0]
         self.handles = drive.add_native(spec, scene.handles.joints, scene.handles.clamp_body)
         add_units(spec, scene.units)
         self.spec, self.drive, self.scene = spec, drive, scene
@@ -53,9 +55,7 @@ class NativeModel:
         """Rest at a uniform arc of ``initial_curvature`` (1/m), the drive state at rest there;
         the scene's tip loads act here too."""
         mujoco.mj_resetData(self.model, self.data)
-        src = self.scene.part
-        self.part._tip_force_world, self.part._tip_moment = src._tip_force_world.copy(), src._tip_moment
-        self.part.apply_loads()
+        self.scene.part.carry_loads(self.part)
         lay = self.scene.layout
         if initial_curvature:
             self.part.set_hinge_angles(np.full(lay.segments, initial_curvature * lay.ds), forward=False)

@@ -112,6 +112,12 @@ class ActuatorPart:
         """Current (instantaneous) bending stiffness of every hinge (N m / rad)."""
         return self._k_bend * self.units.rotational_stiffness * self._stiffness_scale
 
+    def built_hinge_parameters(self):
+        """Every hinge's bending stiffness and damping (internal units) as built or set by
+        :meth:`set_hinge_parameters`, without a drive's present stiffness scale: what a
+        model derived from this one (a native model) starts from."""
+        return self._k_bend.copy(), self.view.built_damping()
+
     def hinge_damping(self) -> np.ndarray:
         """Current viscous damping of every hinge's bending (N m s / rad)."""
         return self.view.damping() * self.units.rotational_damping
@@ -162,6 +168,13 @@ class ActuatorPart:
         """The model's applied forces were cleared (mj_resetData): no moments to apply again."""
         self._moments = None
 
+    def after_data_reset(self) -> None:
+        """After ``mj_resetData`` (which clears qfrc_applied and xfrc_applied): no internal
+        moments to apply again, the tip loads (which persist) applied again. A clamp that
+        moves needs its frame first (``mj_kinematics``), the tip moment's axis."""
+        self.forget_moments()
+        self.apply_loads()
+
     def reapply_moments(self) -> None:
         """Apply the last internal moments again at the present configuration (a beam whose
         moments follow its geometry, before each step; the drives set them every step)."""
@@ -193,17 +206,22 @@ class ActuatorPart:
             raise ParameterError("representation", self.representation,
                                  "'hinge' (per-joint stiffness and damping are a hinge-chain notion)")
         n = self.layout.segments
-        self.revision += 1
+        k = b = None
         if stiffness is not None:
             k = np.broadcast_to(np.asarray(stiffness, float), (n,))
             if not np.all(np.isfinite(k) & (k > 0)):
                 raise ParameterError("stiffness", stiffness, "positive finite values in N m/rad")
-            self._k_bend = k / self.units.rotational_stiffness
-            self.view.set_stiffness(self._k_bend, self._stiffness_scale)
         if damping is not None:
             b = np.broadcast_to(np.asarray(damping, float), (n,))
             if not np.all(np.isfinite(b) & (b >= 0)):
                 raise ParameterError("damping", damping, "finite values >= 0 in N m s/rad")
+        if k is None and b is None:
+            return
+        self.revision += 1
+        if k is not None:
+            self._k_bend = k / self.units.rotational_stiffness
+            self.view.set_stiffness(self._k_bend, self._stiffness_scale)
+        if b is not None:
             self.view.set_damping(b / self.units.rotational_damping)
             self.view.scale_damping(self._stiffness_scale)
 
@@ -244,13 +262,12 @@ class ActuatorPart:
 
     def carry_loads(self, other: "ActuatorPart") -> None:
         """Set this part's tip loads on ``other``, this actuator in a model derived from this
-        one (see :meth:`check_derivable`, which this calls first)."""
-        self.check_derivable()
-        force, moment = self.tip_loads()
-        if force.any():
-            other.set_tip_force(force)
-        if moment:
-            other.set_tip_moment(moment)
+        one (a native model, other segments or another step): the force as it acts in the
+        world (a moving clamp may have turned since it was set), the moment about the hinge
+        axis; callers deriving a model check :meth:`check_derivable` first."""
+        other._tip_force_world = self._tip_force_world * (self.units.force / other.units.force)
+        other._tip_moment = self._tip_moment * (self.units.moment / other.units.moment)
+        other.apply_loads()
 
     def has_tip_load(self) -> bool:
         return bool(self._tip_force_world.any() or self._tip_moment)

@@ -160,7 +160,7 @@ def _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, 
         # over the instants they share); a companion sampled coarser runs to the end
         stop = stop_when_periodic if stop_when_periodic is not None and \
             (interval or duration / DEFAULT_SAMPLES) * wave.frequency <= 1.0 / MIN_SAMPLES_PER_PERIOD else None
-        return rollout(s, voltage, duration, drive=make_drive(drv.name, s, **params),
+        return rollout(s, voltage, duration, drive=type(drv)(s, **params),
                        initial_curvature=initial_curvature, sample_interval=interval, progress=False,
                        check_every=check_every, controller=controller, engine=engine, max_steps=max_steps,
                        stop_when_periodic=stop)

@@ -366,8 +366,7 @@ class Scene:
         """Reset to rest; ``curvature`` (1/m) starts the beam as a uniform arc of that
         curvature (seed 000 starts each experiment from a measured curvature)."""
         mujoco.mj_resetData(self.model, self.data)
-        self.part.forget_moments()           # mj_resetData clears qfrc_applied
-        self.part.apply_loads()              # mj_resetData clears xfrc_applied; tip loads persist
+        self.part.after_data_reset()         # mj_resetData clears qfrc/xfrc_applied; tip loads persist
         self.part.set_bending_stiffness_scale(1.0)
         if curvature:
             self.part.set_hinge_angles(np.full(self.layout.segments, curvature * self.layout.ds), forward=False)

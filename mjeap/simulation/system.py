@@ -489,9 +489,10 @@ class System:
         k0 = self._per_actuator("initial_curvatures", initial_curvatures)
         m, d = self.model, self.data
         mujoco.mj_resetData(m, d)
+        mujoco.mj_kinematics(m, d)           # the clamp frames, the tip moments' axes
         from ..engines.frame import check_initial_curvature
         for p, k in zip(self.parts, k0):
-            p.apply_loads()
+            p.after_data_reset()
             k = check_initial_curvature(k, p.layout.length, "initial_curvatures")
             if k:
                 p.set_hinge_angles(np.full(p.layout.segments, float(k) * p.layout.ds), forward=False)
