@@ -203,7 +203,7 @@ def _mjeap_cantilever(b, T, P, segments, drive=None, repeats=3, engine="loop"):
             "tip_moved_over_next_10pct_per_L": moved}
 
 
-def _mjeap_at_accuracy(b, T, P, target, ref, repeats=3):
+def _mjeap_at_accuracy(T, P, target, ref, repeats=3):
     """The same cantilever with seed 000's drive running, mjeap choosing its model for
     ``target`` (mjeap.accuracy, its quantity sampled at the end only: the settled tip arc's
     curvature against a converged model, relative to its change). The chosen model is then
@@ -333,7 +333,7 @@ def bench_elastica(T=0.05, elements=20, with_pyelastica=True):
     out["pyelastica"] = [err(_pyelastica_cantilever(b, T, P, elements, shifted)) for shifted in (True, False)]
     pe = out["pyelastica"][0]
     target = abs(pe["tip_deflection_error"])
-    out["mjeap_at_pyelastica_accuracy"] = _mjeap_at_accuracy(b, T, P, target, ref)
+    out["mjeap_at_pyelastica_accuracy"] = _mjeap_at_accuracy(T, P, target, ref)
     base = out["mjeap"][0]
     out["ratio"] = {
         "pyelastica_shifted_over_mjeap_20": pe["wall_s"] / base["wall_s"],
