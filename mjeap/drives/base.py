@@ -12,8 +12,10 @@ with ``mjeap.rollout(..., drive="my-drive")`` without touching the package.
 from __future__ import annotations
 
 import functools
+from contextlib import contextmanager
 from typing import ClassVar, Dict, Optional, Tuple, Type
 
+import mujoco
 import numpy as np
 from scipy import signal
 
@@ -240,10 +242,12 @@ class OpenLoop:
     def closed_loop_reason(self) -> Optional[str]:
         return None
 
-    def open_loop_moments(self, v_steps: np.ndarray) -> np.ndarray:
+    def open_loop_moments(self, v_steps: np.ndarray, dt: Optional[float] = None) -> np.ndarray:
         """Bending moment (N m) at every hinge over every step from reset, (steps, segments),
-        for the voltages ``v_steps`` (V) held over the steps; afterwards :meth:`seek` works."""
+        for the voltages ``v_steps`` (V) held over steps of ``dt`` s (default the scene's
+        timestep; a system's own where it steps at another); afterwards :meth:`seek` works."""
         self._v_history = np.asarray(v_steps, dtype=float)
+        self._seek_dt = self.scene.timestep if dt is None else float(dt)
         return self._moment_history(self._v_history)
 
     def seek(self, k: int) -> None:
@@ -254,7 +258,7 @@ class OpenLoop:
             self.reset()
             return
         self._restore_before(k - 1)
-        self.step(float(self._v_history[k - 1]), self.scene.timestep)
+        self.step(float(self._v_history[k - 1]), self._seek_dt)
 
     # hooks of the two above, for open-loop drives
     def _moment_history(self, v: np.ndarray) -> np.ndarray:
@@ -284,20 +288,25 @@ class NativeForm:
         """Set the native model's drive state at rest at the part's present shape (after
         the beam was reset and bent); the activation is zero after mj_resetData."""
 
-    def native_prepare(self, v_steps: np.ndarray) -> None:
-        """Before a native run with the voltages ``v_steps`` (V) held over the steps, so that
-        :meth:`native_signals` can read the drive's signals at any step."""
-        self.open_loop_moments(v_steps)
+    def native_prepare(self, v_steps: np.ndarray, dt: Optional[float] = None) -> None:
+        """Before a native run with the voltages ``v_steps`` (V) held over steps of ``dt`` s
+        (default the scene's timestep; a system's own), so that :meth:`native_signals` can
+        read the drive's signals at any step."""
+        self.open_loop_moments(v_steps, dt)
 
-    def native_signals(self, k: int, part, handles, prefix: str = "") -> Dict[str, float]:
+    def native_signals(self, k: int, part, handles, prefix: str = "", before=None) -> Dict[str, float]:
         """The drive's signals after step ``k`` of a native run, the part holding that
         state: by default the loop drive replayed to step k (:meth:`seek`) on a read-only
         view of its part, so that the replay adds no moment or stiffness to a beam the
-        native model already drives (a system's, :mod:`mjeap.simulation.system`)."""
+        native model already drives (a system's, :mod:`mjeap.simulation.system`). ``before``:
+        the model's full-physics state before step k, which the replayed step starts from
+        as the loop's does (a drive reading the beam's rates needs it: the piezo bimorph's
+        motional current); None: the state after it."""
         own = self.part
         self.part = ReadOnlyPart(own)
         try:
-            self.seek(k)
+            with _state_before(part, before):
+                self.seek(k)
             return self.signals()
         finally:
             self.part = own
@@ -309,11 +318,31 @@ class NativeForm:
         sample at a time (:meth:`native_signals`)."""
         return None
 
-    def native_leave(self, k: int, part, handles, prefix: str = "") -> None:
+    def native_leave(self, k: int, part, handles, prefix: str = "", before=None) -> None:
         """After a native run of ``k`` steps whose final state ``part`` holds: take over that
         state and apply the last step's moments to the drive's own part (the scene), as the
-        loop leaves them; by default the loop drive replayed to step k."""
-        self.seek(k)
+        loop leaves them; by default the loop drive replayed to step k (from ``before``, the
+        native model's state before that step, as :meth:`native_signals`)."""
+        with _state_before(part, before):
+            self.seek(k)
+
+
+@contextmanager
+def _state_before(part, before):
+    """Within the block ``part``'s model holds the full-physics state ``before`` (when not
+    None); the state it held is put back after it."""
+    if before is None:
+        yield
+        return
+    m, d = part.model, part.data
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    now = np.empty(mujoco.mj_stateSize(m, spec))
+    mujoco.mj_getState(m, d, now, spec)
+    mujoco.mj_setState(m, d, before, spec)
+    try:
+        yield
+    finally:
+        mujoco.mj_setState(m, d, now, spec)
 
 
 class ReadOnlyPart:

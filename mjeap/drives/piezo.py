@@ -27,6 +27,19 @@ M / (D w) = f31 (t_p + t_cf) V_eff / D is uniform even on the trapezoidal planfo
 
 Actuator current, eq. (1): I = (2 V_sig - V_bias) / (2 R) + C dV_sig/dt + I_mech, with
 I_mech = sum_j Gamma_j dtheta_j/dt (the seed writes it as K(V_bias) v).
+
+The instant of I_mech. A step holds V_k from t_k; MuJoCo's step (implicit damping, explicit
+springs) is the leapfrog q_{k+1} = q_k + h v_{k+1}, whose velocity v_{k+1} = (q_{k+1} - q_k)/h
+belongs to t_k + h/2: paired with V_k it leads by half a step, and V_k I_mech then carries a
+relative power error of (h / 2 beta)(r^2 - 1), r = f / f_1 (-39 % at f_1/2 with h = beta, the
+PZT default; trust issue, section 1). The rate at the held voltage's instant is the central
+difference (q_{k+1} - q_{k-1}) / 2h = (v_k + v_{k+1}) / 2: with it the step map's electrical
+work balances exactly what its dampers dissipate (multiply the step's equation by
+(q_{k+1} - q_{k-1}) / 2: the mass and spring terms telescope over a period). So I_mech is
+sum_j Gamma_j (v_j,k + v_j,k+1) / 2, the rates before and after the step the voltage was held
+over; every engine reads it so (the threaded and native ones replay the step from the state
+before it). ``tests/test_piezo_power.py`` checks power and phase at 0.3 .. 2 f_1 against
+converged runs and the per-cycle energy balance.
 """
 from __future__ import annotations
 
@@ -73,6 +86,8 @@ class PiezoBimorphDrive(OpenLoop, NativeForm, Drive):
         self._v_prev = None
         self._v = self._dv = 0.0
         self._m = np.zeros(scene.layout.segments)
+        self._rates = np.zeros(scene.layout.segments)
+        self._i_before = None                   # Gamma . (hinge rates before the last step), A
 
     def voltage_range(self):
         return (0.0, float(self.params["bias"]))
@@ -87,12 +102,15 @@ class PiezoBimorphDrive(OpenLoop, NativeForm, Drive):
         self._dv = 0.0
         self.part.set_internal_moments(0.0)
         self._m[:] = 0.0                        # per-hinge moment, N m, written in place
+        self._i_before = None
 
     def step(self, voltage: float, dt: float) -> None:
         np.multiply(self.gamma, voltage - 0.5 * self.params["bias"], out=self._m)
         self.part.set_internal_moments(self._m)
         self._dv = 0.0 if self._v_prev is None else (voltage - self._v_prev) / dt
         self._v = self._v_prev = voltage
+        # the rates the held voltage starts from: half of the motional current's central rate
+        self._i_before = float(self.gamma @ self.part.hinge_rates(self._rates))
 
     def closed_loop_reason(self):
         return None
@@ -123,12 +141,14 @@ class PiezoBimorphDrive(OpenLoop, NativeForm, Drive):
         self._v_prev = None if k == 0 else float(self._v_history[k - 1])
 
     def currents(self):
-        """(resistive, capacitive, motional) current of eq. (1), A, at the scene's present
-        state: the voltage held over the last step, its backward difference over that step
-        (what a sampled dV/dt sees) and the hinge rates now."""
+        """(resistive, capacitive, motional) current of eq. (1), A, of the voltage held over
+        the last step: that voltage, its backward difference over the step (what a sampled
+        dV/dt sees) and the hinges' central rate at the voltage's instant, the mean of their
+        rates before and after the step (module text; before any step, the rates now)."""
         vb = self.params["bias"]
-        return ((2 * self._v - vb) / (2 * self.params["resistance"]), self.params["capacitance"] * self._dv,
-                float(self.gamma @ self.part.hinge_rates()))
+        now = float(self.gamma @ self.part.hinge_rates(self._rates))
+        i_mech = now if self._i_before is None else 0.5 * (self._i_before + now)
+        return ((2 * self._v - vb) / (2 * self.params["resistance"]), self.params["capacitance"] * self._dv, i_mech)
 
     def signals(self) -> Dict[str, float]:
         i_r, i_c, i_m = self.currents()

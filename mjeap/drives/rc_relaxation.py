@@ -187,10 +187,10 @@ class RCRelaxationDrive(NativeForm, Drive):
         part.data.qpos[qadr] = theta - (g - k_inf * theta) / k1
         mujoco.mj_forward(part.model, part.data)
 
-    def native_prepare(self, v_steps):
+    def native_prepare(self, v_steps, dt=None):
         self._v_native = np.asarray(v_steps, dtype=float)
 
-    def native_signals(self, k, part, handles, prefix=""):
+    def native_signals(self, k, part, handles, prefix="", before=None):
         """From the native state: v_c is the activation, the relaxation moment k1 r_j of
         each arm (k r of the loop drive's internal variable), both after step k."""
         z, pm, _ = self._internal_rates()
@@ -221,7 +221,7 @@ class RCRelaxationDrive(NativeForm, Drive):
                 "drive_moment (N m)": self.gamma * vc,
                 "relaxation_moment_mean (N m)": states[:, q0 + qadr] @ k1 / len(k1)}
 
-    def native_leave(self, k, part, handles, prefix=""):
+    def native_leave(self, k, part, handles, prefix="", before=None):
         """The loop drive's state from the native one (v_c, r = k1 r_native / k), its
         moments applied to the scene: a loop run can go on from here."""
         self.native_signals(k, part, handles, prefix)

@@ -82,20 +82,21 @@ def run_native(scene, native, drives: Sequence, v_steps: Sequence[np.ndarray], i
         sd.qpos[:], sd.qvel[:], sd.time = d.qpos[:nq], d.qvel[:nv], d.time
         scene.update_kinematics()
 
-    def take(b, k, state):
+    def take(b, k, state, before):
         mujoco.mj_setState(m, d, state, STATE)
         mujoco.mj_kinematics(m, d)
         if batch[b]:
             rows[b][samples[b].n] = state
-        samples[b].take(k * dt, v_steps[b][k - 1], {} if batch[b] else drives[b].native_signals(k, part, h))
+        samples[b].take(k * dt, v_steps[b][k - 1],
+                        {} if batch[b] else drives[b].native_signals(k, part, h, before=before))
 
     decided = None
     try:
         try:
-            final, bad = roll(m, state0, controls, len(template), spec, n, sample_steps, take, nthread,
-                              ahead_of_stop(samples, dt), spare_datas(native, m))
+            final, bad, before = roll(m, state0, controls, len(template), spec, n, sample_steps, take, nthread,
+                                      ahead_of_stop(samples, dt), spare_datas(native, m))
         except Decided as stop:         # the run ends at the decision (Samples.stop)
-            final, bad, n, decided = stop.state[None], None, stop.step, stop
+            final, bad, before, n, decided = stop.state[None], None, stop.before[None], stop.step, stop
         if bad is not None:
             raise_bad(scene, put, drives, v_steps, bad)
         put(final[-1])
@@ -109,7 +110,7 @@ def run_native(scene, native, drives: Sequence, v_steps: Sequence[np.ndarray], i
     # the scene and the (last) drive as the loop leaves them: final state, last moments applied
     mujoco.mj_setState(m, d, final[-1], STATE)
     mujoco.mj_kinematics(m, d)
-    drives[-1].native_leave(n, part, h)
+    drives[-1].native_leave(n, part, h, before=before[-1])
     scene._step_count = n
     if decided is not None:
         raise decided

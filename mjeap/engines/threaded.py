@@ -83,11 +83,13 @@ def roll(model, state0: np.ndarray, controls, ncontrol: int, control_spec, n: in
          take, nthread: int = 0, max_chunk: Optional[int] = None, spares: Optional[list] = None) -> tuple:
     """The core of both engines: ``mujoco.rollout`` of ``len(state0)`` runs of ``model`` over
     ``n`` steps, in chunks that keep memory bounded. ``controls(s0, c, out)`` fills the
-    (B, c, ncontrol) controls of steps s0 .. s0 + c; ``take(b, k, state)`` is called for
-    every run b at every sample step k >= 1 with its state after that step. Returns
-    (final states (B, nstate), None) or, at the first bad state (not finite, beyond
-    mjMAXVAL, or after a step on which MuJoCo warned), (None, (run, step, state)), after
-    taking the samples before it.
+    (B, c, ncontrol) controls of steps s0 .. s0 + c; ``take(b, k, state, before)`` is called
+    for every run b at every sample step k >= 1 with its state after that step and the state
+    before it (what a replayed drive step starts from). Returns (final states (B, nstate),
+    None, the states one step before them) or, at the first bad state (not finite, beyond
+    mjMAXVAL, or after a step on which MuJoCo warned), (None, (run, step, state), None),
+    after taking the samples before it. A :class:`Decided` raised by ``take`` carries the
+    run's ``state`` and ``before`` there.
 
     Pipelined: while the samples of one chunk are taken (Python, this thread), the next
     chunk rolls out (C, the GIL released) on ``nthread`` threads; a chunk is at most
@@ -151,6 +153,7 @@ def _roll(model, datas, state0, controls, ncontrol, control_spec, n, sample_step
             return ahead.submit(job)
 
         pending = submit(0, state0)
+        before_last = state0
         for j, s0 in enumerate(starts):
             state = pending.result()[0]
             c = state.shape[1]
@@ -162,19 +165,22 @@ def _roll(model, datas, state0, controls, ncontrol, control_spec, n, sample_step
             while i_next < len(sample_steps) and sample_steps[i_next] <= s0 + bad:
                 k = int(sample_steps[i_next])
                 for b in range(B):
+                    i = k - s0 - 1
+                    before = state[b, i - 1] if i > 0 else state0[b]
                     try:
-                        take(b, k, state[b, k - s0 - 1])
+                        take(b, k, state[b, i], before)
                     except Decided as stop:     # the run ends here: its state goes with the decision
-                        stop.step, stop.state = k, np.array(state[b, k - s0 - 1])
+                        stop.step, stop.state, stop.before = k, np.array(state[b, i]), np.array(before)
                         raise
                 i_next += 1
             if run is not None:
-                return None, (run, s0 + bad + 1, state[run, bad])
+                return None, (run, s0 + bad + 1, state[run, bad]), None
+            before_last = np.array(state[:, c - 2]) if c > 1 else state0
             state0 = last
     if any(x.warning[mujoco.mjtWarning.mjWARN_BADQACC].number for x in datas):
         # a warning on the very last step leaves no repeated state behind it
-        return None, (B - 1, n, None)
-    return state0, None
+        return None, (B - 1, n, None), None
+    return state0, None, before_last
 
 
 def run(scene, drives: Sequence, v_steps: Sequence[np.ndarray], initial_curvatures: Sequence[float],
@@ -202,24 +208,29 @@ def run(scene, drives: Sequence, v_steps: Sequence[np.ndarray], initial_curvatur
         for b in range(B):
             out[b][:, bend] = moments[b][s0:s0 + c]
 
-    def take(b, k, state):
+    def replay(drive, k, state, before):
+        """The drive's step k - 1 replayed from the state it started from (as the loop
+        steps it), then the state after it (the read-outs')."""
+        mujoco.mj_setState(m, d, before, STATE)
+        drive.seek(k)
         mujoco.mj_setState(m, d, state, STATE)
+
+    def take(b, k, state, before):
+        replay(drives[b], k, state, before)
         scene.update_kinematics()
-        drives[b].seek(k)
         samples[b].take(k * dt, v_steps[b][k - 1], drives[b].signals())
 
     try:
-        final, bad = roll(m, state0, controls, nv, CONTROL, n, sample_steps, take, nthread, ahead_of_stop(samples, dt),
-                          spare_datas(scene, m))
+        final, bad, before = roll(m, state0, controls, nv, CONTROL, n, sample_steps, take, nthread,
+                                  ahead_of_stop(samples, dt), spare_datas(scene, m))
         decided = None
     except Decided as stop:             # the run ends at the decision (Samples.stop)
-        final, bad, n, decided = stop.state[None], None, stop.step, stop
+        final, bad, before, n, decided = stop.state[None], None, stop.before[None], stop.step, stop
     if bad is not None:
         raise_bad(scene, lambda x: mujoco.mj_setState(m, d, x, STATE), drives, v_steps, bad)
     # leave the scene and the (last) drive as the lockstep loop does: final state, the
     # moments of the last step still applied (seek replays that step)
-    mujoco.mj_setState(m, d, final[-1], STATE)
-    drives[-1].seek(n)
+    replay(drives[-1], n, final[-1], before[-1])
     scene._step_count = n
     scene.update_kinematics()
     if decided is not None:

@@ -658,7 +658,7 @@ class System:
         self.reset(initial_curvatures)
         for a, p, v in zip(self.actuators, self.parts, v_steps):
             if v is not None:
-                a.drive.native_prepare(v)
+                a.drive.native_prepare(v, dt)
                 a.drive.part = p
         active = [(i, v) for i, v in zip(self.actuator_ids, v_steps) if v is not None]
         ctrl_name = None if controller is None else getattr(controller, "name", type(controller).__name__)
@@ -672,13 +672,20 @@ class System:
                 "engine": eng.name, "engine_reason": engine_reason,
                 "units": self.units.describe()}
         ws = np.empty(m.nv)
+        # the state before each sampled step: a drive's signals replay that step from it
+        # (the piezo bimorph's motional current is at the held voltage's instant)
+        full = mujoco.mjtState.mjSTATE_FULLPHYSICS
+        pre = np.empty(mujoco.mj_stateSize(m, full))
+        sampled = np.zeros(n_steps + 1, dtype=bool)
+        sampled[sample_steps] = True
 
         def sample(i, k):
             ws[:] = d.qacc_warmstart
             mujoco.mj_forward(m, d)             # contacts and their forces at this state
             d.qacc_warmstart[:] = ws
             for a, p, smp, v in zip(self.actuators, self.parts, samples, v_steps):
-                sig = {} if a.drive is None else a.drive.native_signals(k, p, a.native, a.prefix)
+                sig = {} if a.drive is None else a.drive.native_signals(k, p, a.native, a.prefix,
+                                                                        before=pre if k else None)
                 smp.take(k * dt, np.nan if v is None else v[max(k - 1, 0)], sig)
             pos[i] = d.xpos * self.units.length
             quat[i] = d.xquat
@@ -693,6 +700,8 @@ class System:
                 self._control(controller(k * dt, self), v_steps, k, ctrl_name)
             for i, v in active:
                 d.ctrl[i] = v[k]
+            if sampled[k + 1]:
+                mujoco.mj_getState(m, d, pre, full)
 
         def check(done, k):
             self._step_count = done
