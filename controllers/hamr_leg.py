@@ -65,23 +65,26 @@ def free_actuator():
 def leg_scene(transmission: Transmission, actuator=None, **scene_kw) -> Scene:
     """The actuator carrying the leg's reflected mass at its tip, sized (scipy brentq on the
     scene's own first mode) so that the loaded actuator resonates at the transmission's
-    resonance."""
+    resonance. ``scene_kw`` go to the scenes; a ``timestep`` only to the loaded one (the
+    modes, hence the mass, do not depend on it; the free actuator's and the lighter trial
+    scenes' stability limits are lower than the loaded scene's)."""
     act = actuator or free_actuator()
     tip = act.length + act.planform.extension_length
-    f_free = Scene(act, gravity=False, **scene_kw).choice.first_frequency
+    search_kw = {k: v for k, v in scene_kw.items() if k != "timestep"}
+    f_free = Scene(act, gravity=False, **search_kw).choice.first_frequency
     if transmission.resonance >= f_free:
         raise ParameterError("transmission.resonance", transmission.resonance,
                              f"a frequency below the free actuator's {f_free:.4g} Hz")
 
-    def scene(mass):
-        return Scene(act, gravity=False, payload=Payload(mass, tip, radius=1e-5), **scene_kw)
+    def scene(mass, kw=search_kw):
+        return Scene(act, gravity=False, payload=Payload(mass, tip, radius=1e-5), **kw)
 
     # one-mode guess, f^2 ~ k / (m + m_eff), with an effective beam mass of 1 mg; the
     # bracket spans four decades around it
     guess = 1e-6 * (f_free / transmission.resonance) ** 2
     mass = optimize.brentq(lambda m: scene(m).choice.first_frequency - transmission.resonance,
                            guess * 1e-2, guess * 1e4, xtol=1e-12, rtol=1e-6)
-    return scene(mass)
+    return scene(mass, scene_kw)
 
 
 def pid_gains(damping_ratio: float, resonance: float, frequency: float, pole: float = 0.5):
@@ -171,9 +174,11 @@ class LegPhaseController:
     def __call__(self, t: float, scene) -> float:
         w = 2 * np.pi * self.frequency
         if self._u is not None:
-            # the current at the end of the last step, with the voltage held over it
+            # the current read after the last step, with the voltage held over it: both belong
+            # to that voltage's instant, the step's start t - dt (mjeap.drives.piezo), not to
+            # t (at the leg's 159 us step, omega dt = 5.7 deg at 100 Hz)
             v_sen = self.est.update(self._u, self.drive.signals()["current (A)"], self.dt)
-            self._sum += v_sen * np.exp(-1j * w * t)
+            self._sum += v_sen * np.exp(-1j * w * (t - self.dt))
             self._n += 1
         if t >= (self._cycle + 1) / self.frequency - 0.5 * self.dt:
             self._end_of_cycle()
@@ -238,13 +243,15 @@ def phase_errors_per_cycle(time, position, frequency: float, desired_phase: floa
 
 def run_leg(transmission: Transmission = SWING, cycles: int = 40, open_loop_cycles: int = 10,
             bias: float = 100.0, amplitude: float = 20.0, frequency: float = 100.0,
-            estimator: Optional[SelfSensingEstimator] = None, gains=None, rrd=None) -> LegRun:
+            estimator: Optional[SelfSensingEstimator] = None, gains=None, rrd=None,
+            timestep: Optional[float] = None) -> LegRun:
     """Run one leg DOF at ``frequency`` (Hz): ``open_loop_cycles`` open loop, then closed.
     The estimator is calibrated on the free actuator unless given (as in the paper, it is
-    not changed for the load); the gains follow from the scene unless given."""
+    not changed for the load); the gains follow from the scene unless given. ``timestep``
+    (s): the leg scene's (default its own, :class:`mjeap.Scene`)."""
     act = free_actuator()
     estimator = estimator or free_estimator(bias)
-    sc = leg_scene(transmission, act)
+    sc = leg_scene(transmission, act, **({} if timestep is None else {"timestep": timestep}))
     if gains is None:
         gains = pid_gains(sc.choice.damping_ratio, sc.choice.first_frequency, frequency)
     ctrl = LegPhaseController(estimator, frequency, amplitude, transmission.desired_phase, gains, open_loop_cycles)

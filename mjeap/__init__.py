@@ -69,3 +69,6 @@ __all__ = ["CATALOG", "Actuator", "Layer", "Planform", "get_actuator", "actuator
            "UnknownNameError", "REPRESENTATIONS", "build_spec", "Scene", "load_mjcf", "DEFAULT_UNITS",
            "UnitSystem", "analytical", "DRIVES", "Drive", "register_drive", "RolloutResult", "free_vibration", "rollout", "rollout_batch",
            "Waveform", "parse_waveform"]
+
+from .optimize import optimize  # noqa: E402  (design optimisation, mjeap.optimize)
+__all__.append("optimize")

@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 import sys
 from pathlib import Path
 from typing import Callable, List, Optional
@@ -24,12 +25,55 @@ def cmd_list(args) -> int:
     return 0
 
 
-def describe(name: str) -> dict:
-    """Every parameter of a catalog actuator with unit and provenance, plus derived values."""
-    from .model import analytical
+def _actuator(name):
+    """The actuator a command names (catalog id or file), read before any work; a layer value
+    outside its material's range (RangeWarning) is told as one line, ``mjeap: warning: ...``."""
+    import warnings
     from .model.catalog import get_actuator
+    from .model.materials import RangeWarning
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        act = get_actuator(name)
+    for w in caught:
+        if issubclass(w.category, RangeWarning):
+            print(f"mjeap: warning: {w.message}", file=sys.stderr)
+        else:
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+    return act
+
+
+def _actuator_file_of(a) -> str:
+    """Where ``a`` comes from: its file, or the catalog's file of a catalog id."""
+    from .model.catalog import CATALOG_DIR
+    return a.source_file or f"{CATALOG_DIR / (a.id + '.toml')} (catalog)"
+
+
+def drive_rows(a) -> dict:
+    """The actuator's own drive and each of its parameters as (value, unit, source, origin):
+    origin 'file' (the actuator's [drive.parameters]), 'generic' (the drive's default: the
+    file gives none) or 'missing' (no default: a run must give it)."""
+    from .drives import default_drive_name, get_drive_class
+    name = default_drive_name(a)
+    cls = get_drive_class(name)
+    units, defaults = cls.parameter_units(), cls.defaults_for(a)
+    own = a.drive_parameters if a.drive == name else {}
+    rows = {}
+    for k in dict.fromkeys([*defaults, *units]):
+        if k in own:
+            rows[k] = (own[k][0], units.get(k, "-"), own[k][2], "file")
+        elif k in defaults:
+            rows[k] = (defaults[k][0], defaults[k][1], defaults[k][2], "generic")
+        else:
+            rows[k] = (None, units[k], "no value: give it in the file's [drive.parameters] or drive_params", "missing")
+    return {"name": name, "model": cls.model_used, "parameters": rows}
+
+
+def describe(name: str) -> dict:
+    """Every parameter of an actuator (catalog id or file) with unit and provenance, its
+    drive's parameters with theirs, plus derived values."""
+    from .model import analytical
     from .simulation.scene import Scene
-    a = get_actuator(name)
+    a = _actuator(name)
     layers = []
     for l in a.layers:
         layers.append({
@@ -49,7 +93,7 @@ def describe(name: str) -> dict:
     scene = Scene(a)
     c = scene.choice
     return {
-        "id": a.id, "title": a.title, "document": a.document, "layers": layers,
+        "id": a.id, "title": a.title, "document": a.document, "file": _actuator_file_of(a), "layers": layers,
         "planform": {"length": (p.length, "m", p.source), "base_width": (p.base_width, "m", p.source),
                      "tip_width": (p.tip_width, "m", p.source),
                      "extension_length": (p.extension_length, "m", p.extension_source),
@@ -60,6 +104,7 @@ def describe(name: str) -> dict:
         "damping_ratio": (a.damping_ratio.value, "-", a.damping_ratio.source),
         "voltage_range": (list(a.voltage_range), "V", a.voltage_source),
         "plane_strain": (a.plane_strain, "-", a.plane_strain_source),
+        "drive": drive_rows(a),
         "derived": {
             "flexural_rigidity_clamp": (EI0, "N m^2", "identified" if a.flexural_rigidity else "multilayer_section"),
             "flexural_rigidity_tip": (float(a.flexural_rigidity_at(a.length)[0]), "N m^2", ""),
@@ -80,7 +125,7 @@ def cmd_show(args) -> int:
     if args.json:
         print(json.dumps(d, indent=2, default=str))
         return 0
-    print(f"{d['id']}: {d['title']}\n  source: {d['document']}\n\nlayers (bottom to top):")
+    print(f"{d['id']}: {d['title']}\n  source: {d['document']}\n  file: {d['file']}\n\nlayers (bottom to top):")
     for l in d["layers"]:
         print(f"  {l['name']} ({l['material']})")
         for k in ("thickness", "width", "youngs_modulus", "poisson_ratio", "density"):
@@ -97,15 +142,72 @@ def cmd_show(args) -> int:
     if d["overrides"]:
         block("identified values (override the layers)", d["overrides"])
     block("model parameters", {k: d[k] for k in ("damping_ratio", "voltage_range", "plane_strain")})
+    _print_drive(d["drive"])
     block("derived", d["derived"])
     return 0
+
+
+def _print_drive(drv: dict) -> None:
+    """The drive's parameters, those not in the file marked (the drive's generic values)."""
+    print(f"\ndrive {drv['name']} ({drv['model']}):" if drv["model"] else f"\ndrive {drv['name']}:")
+    marks = {"file": "  ", "generic": "* ", "missing": "! "}
+    for k, (v, u, s, origin) in drv["parameters"].items():
+        vs = "-" if v is None else (_fmt(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else str(v))
+        print(f"{marks[origin]}{k:<30} {vs:>12} {u:<8} {s}")
+    origins = {r[3] for r in drv["parameters"].values()}
+    if "generic" in origins:
+        print("  * the drive's generic value: the actuator's file gives none")
+    if "missing" in origins:
+        print("  ! no value: a run must give it (the file's [drive.parameters] or --param)")
+    if not drv["parameters"]:
+        print("  (no parameters)")
+
+
+def cmd_materials(args) -> int:
+    """The materials library: a table, one material in full, or JSON."""
+    from .model import materials as mat
+    names = [mat.get_material(args.name).name] if args.name else mat.material_names()
+    if args.json:
+        print(json.dumps({n: material_record(mat.get_material(n)) for n in names}, indent=2))
+        return 0
+    if args.name:
+        m = mat.get_material(args.name)
+        print(f"{m.name}: {m.title}" + (f"\n  {m.notes}" if m.notes else ""))
+        for k in mat.PROPERTIES:
+            p = m.property(k)
+            rng = f"[{_fmt(p.range[0])}, {_fmt(p.range[1])}]"
+            print(f"  {k:<15} {_fmt(p.value):>9} {p.unit:<7} range {rng}  {p.source}")
+        return 0
+    keys = ("youngs_modulus", "density", "poisson_ratio")
+    rows = [["material", "E (Pa)", "range", "density (kg/m^3)", "range", "nu", "range", "title"]]
+    for n in names:
+        m = mat.get_material(n)
+        ps = [m.property(k) for k in keys]
+        rows.append([m.name, *[c for p in ps for c in (_fmt(p.value), f"[{_fmt(p.range[0])}, {_fmt(p.range[1])}]")],
+                     m.title])
+    widths = [max(len(r[i]) for r in rows) for i in range(len(rows[0]) - 1)]
+    for r in rows:
+        print("  ".join(c.rjust(w) if i in (1, 3, 5) else c.ljust(w) for i, (c, w) in enumerate(zip(r, widths)))
+              + "  " + r[-1])
+    print("\nsources: mjeap materials NAME (or --json); a layer names one with material = \"NAME\" in an actuator file")
+    return 0
+
+
+def material_record(m) -> dict:
+    """A material as JSON: title, notes, each property's value, unit, range and source."""
+    from .model.materials import PROPERTIES
+    return {"title": m.title, "notes": m.notes,
+            **{k: {"value": m.property(k).value, "unit": m.property(k).unit, "range": list(m.property(k).range),
+                   "source": m.property(k).source} for k in PROPERTIES}}
 
 
 def _scene_from_args(args):
     from .model.discretize import Payload
     from .simulation.scene import Scene
     payload = Payload.parse(args.payload) if args.payload else None
-    return Scene(args.name, representation=args.representation, segments=args.segments,
+    from .simulation.scene import DEFAULT_SEGMENTS
+    return Scene(_actuator(args.name), representation=args.representation,
+                 segments=DEFAULT_SEGMENTS if args.segments is None else args.segments,
                  orientation=args.orientation, payload=payload, timestep=args.timestep,
                  integrator=args.integrator)
 
@@ -143,7 +245,9 @@ def cmd_rollout(args) -> int:
     from .simulation.accuracy import check_accuracy
     if args.accuracy is not None:
         check_accuracy(args.accuracy)
-        for flag, given in (("--timestep", args.timestep), ("--estimate-error", args.estimate_error or None)):
+        # the target chooses segments, integrator and timestep: each given alongside it is refused alike
+        for flag, given in (("--segments", args.segments), ("--integrator", args.integrator),
+                            ("--timestep", args.timestep), ("--estimate-error", args.estimate_error or None)):
             if given is not None:
                 raise ParameterError(flag, given, f"no {flag} with --accuracy (the target chooses the model and "
                                      "estimates its error)")
@@ -153,7 +257,8 @@ def cmd_rollout(args) -> int:
                 initial_curvature=args.initial_curvature, rrd=args.rrd, csv_path=args.csv,
                 progress=None if not args.quiet else False, engine=args.engine, max_steps=args.max_steps,
                 accuracy=args.accuracy, estimate_error=args.estimate_error)
-    summary = {"actuator": scene.actuator.id, "drive": r.meta["drive"], "engine": r.meta["engine"],
+    summary = {"actuator": scene.actuator.id, "actuator_file": scene.actuator.source_file,
+               "drive": r.meta["drive"], "engine": r.meta["engine"],
                "engine_reason": r.meta.get("engine_reason", ""),
                "voltage": args.voltage,
                "duration_s": args.duration, "segments": r.meta["scene"]["segments"],
@@ -193,8 +298,50 @@ def cmd_validate(args) -> int:
     return 1 if failed else 0
 
 
+#: where mjeap identify writes the identified actuator file unless told (--out)
+IDENTIFIED = "out/identified.toml"
+
+
+def _identified_out(args, act) -> str:
+    """The identified file's path (--out, default IDENTIFIED), checked before any work: a
+    writable path other than the actuator file it comes from (a hand-written file's comments
+    and units would be lost)."""
+    from .io.outputs import check_outputs
+    out = args.out or IDENTIFIED
+    if act.source_file and Path(out).resolve() == Path(act.source_file).resolve():
+        raise ParameterError("--out", out, f"a path other than the actuator file {act.source_file}",
+                             "it would replace the hand-written file, and its comments and units with it")
+    check_outputs(**{"--out": out})
+    return out
+
+
+def _write_identified(act, out: str) -> str:
+    """Write ``act`` to ``out`` whole or not at all (mjeap.io.outputs.replacing), once its
+    drive was built on it (an identified value the drive refuses is never written)."""
+    from .drives import make_drive
+    from .io.outputs import replacing
+    from .model.actuator_file import actuator_toml
+    from .simulation.scene import Scene
+    make_drive(None, Scene(act, segments=2, gravity=False))
+    text = actuator_toml(act)
+    with replacing(out, "--out") as tmp:
+        tmp.write_text(text, encoding="utf-8")
+    return out
+
+
 def cmd_identify_step(args) -> int:
-    from .analysis.identify import fit_step_response, read_columns
+    from .analysis.identify import fit_step_response, given_rows, read_columns, step_actuator, step_rows
+    act = given = None
+    if args.actuator is not None:       # the file to put the fit in: checked before any work
+        act = _actuator(args.actuator)
+        given = given_rows(_params(args.param), "mjeap identify step")
+        step_rows(act, given)
+        out_path = _identified_out(args, act)
+    else:
+        for flag, v in (("--out", args.out), ("--param", args.param)):
+            if v is not None:
+                raise ParameterError(flag, v if flag == "--out" else " ".join(v),
+                                     f"{flag} only with --actuator (the actuator file the identified parameters go in)")
     d = read_columns(args.file, [args.time_column, args.curvature_column])
     fit = fit_step_response(d[args.time_column], d[args.curvature_column], args.voltage, args.t_step)
     out = {"fit": "kappa(t) = A + B exp(-p t) + C exp(-a t)", "A_per_m": fit.A, "B_per_m": fit.B, "C_per_m": fit.C,
@@ -204,29 +351,56 @@ def cmd_identify_step(args) -> int:
            "drive": "rc-relaxation", "drive_parameters": fit.drive_parameters(),
            "use": "mjeap rollout ACTUATOR --drive rc-relaxation " +
                   " ".join(f"--param {k}={v:.6g}" for k, v in fit.drive_parameters().items())}
+    if act is not None:
+        out["actuator_file"] = _write_identified(step_actuator(act, fit, args.file, given), out_path)
+        out["use"] = f"mjeap rollout {out_path} --voltage step:{args.voltage:g}V --duration ..."
     print(json.dumps(out, indent=2))
     return 0
 
 
 def cmd_identify_hinges(args) -> int:
-    from .analysis.identify import fit_hinge_parameters, read_columns
+    from .analysis import identify as ident
     scene = _scene_from_args(args)
-    d = read_columns(args.file, [args.time_column, args.tip_column])
-    fit = fit_hinge_parameters(scene, d[args.time_column], d[args.tip_column], args.voltage, drive=args.drive,
-                               drive_params=_params(args.param))
-    print(json.dumps({"stiffness_N_m_per_rad": fit.stiffness, "stiffness_std": fit.stiffness_std,
-                      "damping_N_m_s_per_rad": fit.damping, "damping_std": fit.damping_std,
-                      "rms_residual_m": fit.rms_residual, "simulations": fit.evaluations,
-                      "segments": scene.layout.segments}, indent=2))
+    params = _params(args.param)
+    given = ident.given_rows(params, "mjeap identify hinges")
+    ident.file_drive_rows(scene.actuator, args.drive, given)        # checked before the fit, as is --out
+    out_path = _identified_out(args, scene.actuator)
+    d = ident.read_columns(args.file, [args.time_column, args.tip_column])
+    t, y = d[args.time_column], d[args.tip_column]
+    fit = ident.fit_hinge_parameters(scene, t, y, args.voltage, drive=args.drive, drive_params=params)
+    out = {"stiffness_N_m_per_rad": fit.stiffness, "stiffness_std": fit.stiffness_std,
+           "damping_N_m_s_per_rad": fit.damping, "damping_std": fit.damping_std,
+           "rms_residual_m": fit.rms_residual, "simulations": fit.evaluations,
+           "segments": scene.layout.segments}
+    act = ident.hinge_actuator(scene, fit, args.file, drive=args.drive, given=given)
+    err, swing = ident.reproduction_error(scene, fit, act, t, args.voltage, args.drive, params)
+    out.update(flexural_rigidity_N_m2=act.flexural_rigidity.value, damping_ratio=act.damping_ratio.value,
+               identified_file_rms_m=err)
+    if not err <= ident.REPRODUCE * swing:
+        print(json.dumps(out, indent=2))
+        raise ParameterError("identified actuator", f"{act.id} off the fitted trajectory by {err:.3g} m rms "
+                             f"({err / swing:.1%} of its swing)", f"a file that reproduces the fit within "
+                             f"{ident.REPRODUCE:.0%} of the swing", f"the file's EI and damping ratio do not give the "
+                             f"fitted hinges under the {act.drive} drive: a drive whose moment scales with EI (rc-"
+                             "relaxation's gain is a curvature per volt) cannot carry a hinge stiffness, identify it "
+                             f"with mjeap identify step; nothing written to {out_path}")
+    out["actuator_file"] = _write_identified(act, out_path)
+    print(json.dumps(out, indent=2))
     return 0
+
+
+#: how a command's actuator argument reads
+ACTUATOR_HELP = ("catalog id (mjeap list) or actuator file: a name ending in .toml or holding a path separator "
+                 "is a file (./NAME for a file named like an id)")
 
 
 def add_scene_args(p: argparse.ArgumentParser) -> None:
     from .model.mjcf import REPRESENTATIONS
     from .model.discretize import ORIENTATIONS
     from .simulation.scene import DEFAULT_SEGMENTS, INTEGRATORS
-    p.add_argument("name", help="catalog id (see `mjeap list`)")
-    p.add_argument("--segments", type=int, default=DEFAULT_SEGMENTS, help="number of segments (>= 2)")
+    p.add_argument("name", help=ACTUATOR_HELP)
+    p.add_argument("--segments", type=int, default=None,
+                   help=f"number of segments (>= 2; default {DEFAULT_SEGMENTS}; chosen by --accuracy where given)")
     p.add_argument("--representation", choices=REPRESENTATIONS, default="hinge")
     p.add_argument("--payload", help="tip payload MASS@POSITION[,point|,r=RADIUS|,I=INERTIA], e.g. 12.6mg@6.27mm "
                    "(NdFeB sphere) or 12.6mg@6.27mm,point (no rotary inertia)")
@@ -244,39 +418,48 @@ def _value(text: str):
         return text
 
 
-def _sweep_values(spec: str, random: bool):
-    """NAME=a,b,c (list) | NAME=lo:hi:n (n values, linspace) | NAME=lo..hi (random range)."""
+def _sweep_values(spec: str, random: bool, actuator=None):
+    """NAME=a,b,c (list) | NAME=lo:hi:n (n values, linspace) | NAME=lo..hi (random range);
+    values SI or with the parameter's unit (``actuator.length=8mm:16mm:5``,
+    :func:`mjeap.design.to_value`; ``actuator`` resolves drive.NAME's units)."""
+    from .design import to_value
     name, sep, rhs = spec.partition("=")
     if not sep or not rhs:
         raise ParameterError("--vary", spec, "NAME=a,b,c or NAME=lo:hi:n (grid) or NAME=lo..hi (with --random)")
     name = name.strip()
     form = "NAME=a,b,c or NAME=lo:hi:n (grid) or NAME=lo..hi (with --random)"
+    num = lambda x: float(to_value(name, x.strip(), actuator))       # noqa: E731
     try:
         if ".." in rhs:
             if not random:
                 raise ParameterError("--vary", spec, "a range lo..hi only with --random N")
-            lo, hi = (float(x) for x in rhs.split(".."))
+            lo, hi = (num(x) for x in rhs.split(".."))
             return name, (lo, hi)
         if ":" in rhs:
             lo, hi, n = rhs.split(":")
             if int(n) < 1:
                 raise ValueError("n < 1")
-            return name, [float(x) for x in np.linspace(float(lo), float(hi), int(n))]
+            from .sweep import check_design_size       # the count, checked before the values are made
+            check_design_size(int(n), "--vary", f"{spec}: {int(n):,} values of {name}")
+            return name, [float(x) for x in np.linspace(num(lo), num(hi), int(n))]
     except ValueError as e:
         if isinstance(e, ParameterError):
             raise
         raise ParameterError("--vary", spec, form + " with numbers (n a positive integer)") from None
-    return name, [_value(v) for v in rhs.split(",")]
+    return name, [to_value(name, v.strip(), actuator) for v in rhs.split(",")]
 
 
 def cmd_sweep(args) -> int:
     from . import sweep
-    values = dict(_sweep_values(v, args.random is not None) for v in (args.vary or []))
+    from .design import to_value
+    raw = dict(kv.partition("=")[::2] for kv in (args.set or []))
+    actuator = raw.get("actuator", sweep.PARAMETERS["actuator"])
+    values = dict(_sweep_values(v, args.random is not None, actuator) for v in (args.vary or []))
     if not values:
         raise ParameterError("--vary", None, "at least one NAME=VALUES")
     points = sweep.random_design(args.random, args.seed, **values) if args.random is not None else \
         sweep.grid(**values)
-    base = {k: _value(v) for k, v in (kv.partition("=")[::2] for kv in (args.set or []))}
+    base = {k: to_value(k, v, actuator) for k, v in raw.items()}
     try:
         record = [int(i) for i in args.record.split(",")] if args.record else []
     except ValueError:
@@ -301,6 +484,27 @@ def cmd_sweep(args) -> int:
     return 0
 
 
+def cmd_optimize(args) -> int:
+    from .optimize import optimize
+    from .design import to_value
+    vary = {}
+    for spec in args.vary or []:
+        name, sep, rhs = spec.partition("=")
+        if not sep or not name.strip() or not rhs.strip():
+            raise ParameterError("--vary", spec, "NAME=LOW:HIGH, e.g. actuator.length=5mm:15mm")
+        vary[name.strip()] = rhs.strip()
+    base = {k: to_value(k, v, args.name) for k, v in (kv.partition("=")[::2] for kv in (args.set or []))}
+    r = optimize(args.name, vary, maximize=args.maximize, minimize=args.minimize, subject_to=args.subject_to or (),
+                 voltage=args.voltage, duration=args.duration, base=base,
+                 metrics=[m for m in (args.metrics or "").split(",") if m], method=args.method, starts=args.starts,
+                 seed=args.seed, max_evaluations=args.max_evaluations, out=args.out,
+                 progress=False if args.quiet else None)
+    print(json.dumps(r.as_dict(), indent=2, default=float))
+    if not r.success:
+        print(f"mjeap optimize: {r.message}", file=sys.stderr)
+    return 0 if r.success else 1
+
+
 def cmd_robot(args) -> int:
     from .robots import get
     return get(args.name).main(args.options) or 0
@@ -310,10 +514,14 @@ def build_parser() -> argparse.ArgumentParser:
     ap = argparse.ArgumentParser(prog="mjeap", description=__doc__)
     sub = ap.add_subparsers(dest="command", required=True)
     sub.add_parser("list", help="list the catalog").set_defaults(func=cmd_list)
-    p = sub.add_parser("show", help="parameters, provenance and derived values of an actuator")
-    p.add_argument("name")
+    p = sub.add_parser("show", help="parameters, provenance and derived values of an actuator (catalog id or file)")
+    p.add_argument("name", help=ACTUATOR_HELP)
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_show)
+    p = sub.add_parser("materials", help="the materials library an actuator file's layers name (mjeap.model.materials)")
+    p.add_argument("name", nargs="?", help="one material in full: each property's value, unit, range and source")
+    p.add_argument("--json", action="store_true", help="every property with value, unit, range and source as JSON")
+    p.set_defaults(func=cmd_materials)
     p = sub.add_parser("mjcf", help="write the MJCF model of an actuator")
     add_scene_args(p)
     p.add_argument("-o", "--output", help="output file (default: stdout)")
@@ -356,13 +564,16 @@ def build_parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_validate)
     p = sub.add_parser("sweep", help="parameter study: rollouts reduced to metrics, streamed to CSV, resumable")
     p.add_argument("--vary", action="append", metavar="NAME=VALUES",
-                   help="a,b,c | lo:hi:n (grid) | lo..hi (with --random); NAME is a point parameter "
-                        "(actuator, payload_mass, amplitude, frequency, segments, ...) or drive.NAME (repeatable)")
+                   help="a,b,c | lo:hi:n (grid) | lo..hi (with --random), SI or with a unit (8mm:16mm:5); NAME is a "
+                        "point parameter (actuator, payload_mass, amplitude, frequency, segments, ...), drive.NAME or "
+                        "actuator.NAME (actuator.length, actuator.layers.LAYER.thickness, ...; repeatable)")
     p.add_argument("--set", action="append", metavar="NAME=VALUE", help="fixed parameter for every point (repeatable)")
     p.add_argument("--random", type=int, metavar="N", help="N random points instead of the full grid")
     p.add_argument("--seed", type=int, default=0, help="seed of the random design")
     p.add_argument("--metrics", default="peak_to_peak,returns",
-                   help="comma list: peak_to_peak, returns, settling_time, max_stress_proxy, max_tip_deflection")
+                   help="comma list: peak_to_peak, returns, settling_time, max_stress_proxy, max_tip_deflection, "
+                        "first_frequency, mass, free_deflection, blocked_force, energy_density, peak_power, "
+                        "energy_per_cycle")
     p.add_argument("--out", default="out/sweep.csv", help="results CSV (appended; finished points are skipped)")
     from .sweep import EXECUTORS
     p.add_argument("--executor", choices=EXECUTORS, default="processes")
@@ -371,6 +582,34 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--record", help="comma list of point indices that also write a .rrd")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_sweep)
+    p = sub.add_parser("optimize", help="design optimisation: maximise or minimise a metric over bounded actuator, "
+                       "drive and payload parameters, subject to constraints (scipy)")
+    p.add_argument("name", help="the base actuator: catalog id or actuator file (.toml)")
+    p.add_argument("--vary", action="append", metavar="NAME=LOW:HIGH", required=True,
+                   help="a bounded parameter, SI or with a unit: actuator.length=5mm:15mm, "
+                        "actuator.roles.piezo.thickness=100um:150um, drive.bias=100:200, payload_mass=0:5mg (repeatable)")
+    goal = p.add_mutually_exclusive_group(required=True)
+    goal.add_argument("--maximize", metavar="METRIC", help="the metric to maximise (free_deflection, blocked_force, "
+                      "energy_density, first_frequency, ...)")
+    goal.add_argument("--minimize", metavar="METRIC", help="the metric to minimise (mass, peak_power, ...)")
+    p.add_argument("--subject-to", action="append", metavar="EXPR",
+                   help='a constraint "METRIC>=VALUE" or "METRIC<=VALUE" (SI or with a unit; repeatable)')
+    p.add_argument("--voltage", help="waveform of the rollouts the metrics need: step:200V, sine:50V@100Hz,offset=100V")
+    p.add_argument("--duration", type=float, help="simulated time of each rollout (s; a step needs one)")
+    p.add_argument("--set", action="append", metavar="NAME=VALUE",
+                   help="a fixed sweep setting (segments, orientation, payload_mass, ...; repeatable)")
+    p.add_argument("--metrics", help="more metrics to record at every evaluation (comma list)")
+    from .optimize import METHODS
+    p.add_argument("--method", choices=METHODS, default="slsqp",
+                   help="slsqp (local, from the box's centre and --starts - 1 seeded points; default) or "
+                        "differential-evolution (global, then polished by SLSQP)")
+    p.add_argument("--starts", type=int, default=3, help="SLSQP starts: the centre and seeded points (default 3)")
+    p.add_argument("--seed", type=int, default=0, help="seed of the starts / the evolution")
+    p.add_argument("--max-evaluations", type=int, default=400, help="at most this many evaluations (default 400)")
+    p.add_argument("--out", default="out/optimize",
+                   help="folder for result.json, evaluations.csv (a rerun reads it as a cache) and optimum.toml")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=cmd_optimize)
     p = sub.add_parser("identify", help="fit the papers' models to measured data (CSV with a header)")
     isub = p.add_subparsers(dest="what", required=True)
     q = isub.add_parser("step", help="seed 000: transfer function from a curvature step response")
@@ -379,6 +618,11 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--t-step", type=float, default=0.0, help="time of the step (s)")
     q.add_argument("--time-column", default="time")
     q.add_argument("--curvature-column", default="tip_curvature")
+    q.add_argument("--actuator", help="catalog id or actuator file (.toml) to put the identified rc-relaxation "
+                   f"parameters in, written to --out (default {IDENTIFIED})")
+    q.add_argument("--param", action="append", metavar="KEY=VALUE",
+                   help="with --actuator: an rc-relaxation parameter the step does not identify (capacitance)")
+    q.add_argument("--out", help=f"with --actuator: the identified actuator file (default {IDENTIFIED})")
     q.set_defaults(func=cmd_identify_step)
     q = isub.add_parser("hinges", help="seed 001: joint stiffness and damping from a tip trajectory")
     add_scene_args(q)
@@ -388,6 +632,8 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--param", action="append", metavar="KEY=VALUE", help="drive parameter (repeatable)")
     q.add_argument("--time-column", default="time")
     q.add_argument("--tip-column", default="tip_y", help="tip deflection column (m)")
+    q.add_argument("--out", help=f"the identified actuator file: the actuator with EI = k L/N and the damping ratio "
+                   f"of the fitted joints (default {IDENTIFIED})")
     q.set_defaults(func=cmd_identify_hinges)
     return ap
 
@@ -395,6 +641,8 @@ def build_parser() -> argparse.ArgumentParser:
 # ---------------------------------------------------------------- running a command
 #: exit codes of an interrupted command: 128 + the signal's number, as a shell reports it
 EXIT_CTRL_C, EXIT_SIGTERM = 130, 143
+#: exit code when stdout's reader went away (128 + SIGPIPE, as a shell reports it)
+EXIT_BROKEN_PIPE = 141
 
 
 def run_command(call: Callable[[], Optional[int]], prog: str = "mjeap") -> int:
@@ -419,6 +667,12 @@ def run_command(call: Callable[[], Optional[int]], prog: str = "mjeap") -> int:
         for note in getattr(e, "__notes__", ()):
             print(f"{prog}: error: {note}", file=sys.stderr)
         return EXIT_SIGTERM if term else EXIT_CTRL_C
+    except BrokenPipeError:
+        # the reader of stdout went away (``mjeap ... | head``): the outputs are written; say
+        # so once on stderr, and point stdout at /dev/null so that Python's exit flush is quiet
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        print(f"{prog}: stdout was closed by its reader; the outputs asked for are written", file=sys.stderr)
+        return EXIT_BROKEN_PIPE
     return 0 if code is None else int(code)
 
 

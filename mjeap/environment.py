@@ -30,7 +30,7 @@ from .drives import make_drive
 from .errors import MjeapError, check_positive, check_range
 from .io.outputs import guarded, provenance
 from .simulation.scene import Scene
-from .tracking import (check_curvature_range, check_mass_range, default_reference, draw_episode, observe, step_lockstep, tracking_reward, VoltageLimiter)
+from .tracking import (check_curvature_range, check_mass_range, default_reference, draw_episode, observe, step_lockstep, tracking_reward, VoltageLimiter, warn_heavy_range)
 from .versions import dm_control_problem
 
 install_mujoco_warnings()         # dm_control's import installed its own MuJoCo warning handler
@@ -150,6 +150,7 @@ def make_environment(actuator: str = "pedot-micro", reference: Optional[Callable
     check_dm_control()
     reference = default_reference if reference is None else reference
     scene = Scene(actuator, orientation=orientation, payload=payload, segments=segments)
+    warn_heavy_range(check_mass_range(payload_mass_range), scene, 3)     # the Scene's unit check, on the draws
     check_curvature_range(initial_curvature_range, scene.layout.length)
     drv = make_drive(drive, scene, **(drive_params or {}))
     check_range("control_interval", control_interval, scene.timestep, time_limit, "s")

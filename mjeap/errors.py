@@ -2,6 +2,8 @@
 from __future__ import annotations
 
 import difflib
+import re
+import sys
 from typing import Iterable, Optional
 
 
@@ -138,3 +140,62 @@ def install_mujoco_warnings() -> None:
     as dm_control installed its own handler)."""
     import mujoco
     mujoco.set_mju_user_warning(_mujoco_warning)
+
+
+# ---------------------------------------------------------------- registries (plug-ins)
+#: a registered name: letters, digits, '-' and '_' (a command-line choice, a CSV column)
+_PLUGIN_NAME = re.compile(r"[A-Za-z0-9_-]+")
+
+
+def describe_plugin(entry) -> str:
+    """``entry`` in words for a refusal: 'class X', 'function f', 'X instance'."""
+    if isinstance(entry, type):
+        return f"class {entry.__qualname__}"
+    if hasattr(entry, "__qualname__"):
+        return f"function {entry.__qualname__}"
+    return f"{type(entry).__qualname__} instance"
+
+
+def plugin_origin(entry) -> Optional[str]:
+    """Where ``entry`` was defined: module.qualname of a class or function, or of an
+    instance's class; None where that does not tell one definition from another (a lambda,
+    an instance of a built-in type such as ``functools.partial``). A module run as
+    ``python -m`` counts as the module it is."""
+    obj = entry if hasattr(entry, "__qualname__") else type(entry)
+    module = getattr(obj, "__module__", None)
+    if "<lambda>" in obj.__qualname__ or (module in (None, "builtins", "functools") and obj is not entry):
+        return None
+    if module == "__main__":
+        module = getattr(getattr(sys.modules.get("__main__"), "__spec__", None), "name", None) or module
+    return f"{module}.{obj.__qualname__}"
+
+
+def check_registration(kind: str, registry, name, entry, *, lacks: Optional[str] = None, expected: str = "",
+                       reserved: Iterable[str] = (), replace: bool = False, how: str = "register",
+                       origin=plugin_origin) -> str:
+    """The one check of every registry (engines, drives, beam builders, robots, sweep
+    metrics); returns ``name``. A ParameterError naming the ``kind`` and the entry where:
+
+    * it ``lacks`` something the registry needs (the reason, in words; ``expected``: what
+      it should be);
+    * ``name`` is not a non-empty str of letters, digits, '-' and '_', or is ``reserved``;
+    * ``name`` is taken, unless ``replace`` (``how(..., replace=True)``) or the entry there
+      has the same ``origin`` (the same definition: a module re-imported or reloaded
+      registers again)."""
+    given = describe_plugin(entry) + (f" named {name!r}" if isinstance(name, str) and name else "")
+    if lacks is not None:
+        raise ParameterError(kind, given, expected, lacks)
+    reserved = tuple(reserved)
+    if not isinstance(name, str) or not _PLUGIN_NAME.fullmatch(name) or name in reserved:
+        raise ParameterError(f"{kind} name", name, "a non-empty str of letters, digits, '-' and '_'"
+                             + (f", not {', '.join(map(repr, reserved))}" if reserved else ""),
+                             f"{how} given {describe_plugin(entry)}")
+    old = registry.get(name)
+    if old is not None and old is not entry and not replace:
+        was = origin(old)
+        if was is None or was != origin(entry):
+            raise ParameterError(f"{kind} name", name, f"a name not registered yet (taken: {', '.join(registry)}), "
+                                 f"or {how}(..., replace=True) to replace the {kind} {name!r}",
+                                 f"{name!r} is already {was or describe_plugin(old)}; {how} given "
+                                 f"{describe_plugin(entry)}")
+    return name

@@ -31,9 +31,9 @@ from .model.catalog import get_actuator
 from .model.discretize import Payload
 from .drives import make_drive
 from .errors import MjeapError, ParameterError, check_integer, check_positive, check_range
-from .engines.loop import divergence_error
+from .engines.loop import divergence_error, window_state
 from .simulation.scene import Scene, diverged
-from .tracking import (VoltageLimiter, check_curvature_range, check_mass_range, default_reference, draw_episode, observe, step_lockstep, tracking_reward)
+from .tracking import (VoltageLimiter, check_curvature_range, check_mass_range, default_reference, draw_episode, observe, step_lockstep, tracking_reward, warn_heavy_range)
 
 __all__ = ["CurvatureTrackingEnv", "ENV_ID"]
 
@@ -112,6 +112,7 @@ class CurvatureTrackingEnv(gymnasium.Env):
 
         # -- the scene and its drive ----------------------------------------------------
         self.scene = Scene(act, orientation=orientation, payload=payload, segments=segments)
+        warn_heavy_range(mass_range, self.scene)       # the Scene's unit check, on the masses drawn
         self.drive = make_drive(drive, self.scene, **(drive_params or {}))
         check_range("control_interval", control_interval, self.scene.timestep, time_limit, "s")
         self.reference = default_reference if reference is None else reference
@@ -122,6 +123,7 @@ class CurvatureTrackingEnv(gymnasium.Env):
         self._step_limit = time_limit / self.control_timestep     # as dm_control's control.Environment
         self.metadata = {**type(self).metadata, "render_fps": 1.0 / self.control_timestep}
         self._limiter = VoltageLimiter()
+        self._window = None
         self.episode, self._steps = {}, 0
         self.scene.reset()
         self.drive.reset(0.0)
@@ -161,7 +163,8 @@ class CurvatureTrackingEnv(gymnasium.Env):
         warned = [w.name for w in BAD_STATE_WARNINGS if d.warning[w].number > 0]
         if not warned and not diverged(d):
             return ""
-        why = str(divergence_error(self.scene, self.drive, self.voltage, self.scene._step_count))
+        why = str(divergence_error(self.scene, self.drive, self.voltage, self.scene._step_count,
+                                   window=(self._window, self._n_sub)))
         return why + (f" MuJoCo warned: {', '.join(warned)}." if warned else "")
 
     # -- the Gymnasium API -------------------------------------------------------------
@@ -188,6 +191,7 @@ class CurvatureTrackingEnv(gymnasium.Env):
         terminated, truncated, info) with ``info``: time_s, voltage_V (the voltage applied),
         saturated_steps, episode and, on divergence, divergence."""
         self.voltage = self._limiter(action, self.drive)
+        self._window = window_state(self.scene, self._window)   # a divergence in this step replays from here
         step_lockstep(self.scene, self.drive, self.voltage, self._n_sub)
         self._steps += 1
         info = self._info()

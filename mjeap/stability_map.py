@@ -10,6 +10,8 @@ from pathlib import Path
 import numpy as np
 
 from .cli import arg_integer, arg_output, parse_args
+from .io.outputs import replacing
+from .io.recording import rrd_file
 from .analysis.stability import MAP_BASE, column_limits, simulated_edges
 from .sweep import EXECUTORS, grid, read_results, run_sweep
 
@@ -86,11 +88,13 @@ def main(argv=None):
         ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2)
         ax.set_title("pedot-micro standing up, l_e = 6.27 mm, 0.1 Hz")
         fig.tight_layout()
-        fig.savefig(out / "stability_map.png", dpi=120)
+        with replacing(out / "stability_map.png", "--out") as tmp:
+            fig.savefig(tmp, dpi=120, format="png")
         lines.insert(2, "![stability map](stability_map.png)\n")
     except ImportError:
         lines.append("\n(figure skipped: pip install -e '.[report]' for matplotlib)")
-    (out / "report.md").write_text("\n".join(lines) + "\n")
+    with replacing(out / "report.md", "--out") as tmp:
+        tmp.write_text("\n".join(lines) + "\n")
 
     # the recording: the report beside the map as a figure (axes, units, legend); without
     # matplotlib the report's tables alone
@@ -101,17 +105,14 @@ def main(argv=None):
     if figure.exists():
         views.append(rrb.Spatial2DView(origin="/figure", name="payload mass (mg) x amplitude (V)"))
     rec = rr.RecordingStream("mjeap stability map")
-    rec.save(str(out / "stability_map.rrd"),
-             default_blueprint=rrb.Blueprint(rrb.Horizontal(*views, column_shares=[2, 3][:len(views)]),
-                                             rrb.BlueprintPanel(state="collapsed"),
-                                             rrb.SelectionPanel(state="collapsed"), rrb.TimePanel(state="collapsed")))
-    if figure.exists():
-        rec.log("figure", rr.EncodedImage(path=figure), static=True)
-    table = ["", "| payload (mg) | amplitude (V) | returns |", "|---|---|---|"]
-    table += [f"| {mm:.1f} | {vv:.3g} | {'yes' if o else 'no'} |" for mm, vv, o in zip(m, v, ok)]
-    rec.log("report", rr.TextDocument("\n".join([x for x in lines if not x.startswith("![")] + table),
-                                      media_type="text/markdown"), static=True)
-    rec.flush()
-    rec.disconnect()
+    bp = rrb.Blueprint(rrb.Horizontal(*views, column_shares=[2, 3][:len(views)]), rrb.BlueprintPanel(state="collapsed"),
+                       rrb.SelectionPanel(state="collapsed"), rrb.TimePanel(state="collapsed"))
+    with replacing(out / "stability_map.rrd", "--out") as tmp, rrd_file(rec, tmp, bp):
+        if figure.exists():
+            rec.log("figure", rr.EncodedImage(path=figure), static=True)
+        table = ["", "| payload (mg) | amplitude (V) | returns |", "|---|---|---|"]
+        table += [f"| {mm:.1f} | {vv:.3g} | {'yes' if o else 'no'} |" for mm, vv, o in zip(m, v, ok)]
+        rec.log("report", rr.TextDocument("\n".join([x for x in lines if not x.startswith("![")] + table),
+                                          media_type="text/markdown"), static=True)
     print("\n".join(lines))
     print(f"wrote {out / 'report.md'}, {out / 'stability_map.rrd'}")

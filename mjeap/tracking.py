@@ -27,8 +27,8 @@ from .errors import ParameterError
 from .engines.frame import check_initial_curvature, one_voltage
 from .engines import stepper
 
-__all__ = ["default_reference", "check_curvature_range", "check_mass_range", "draw_episode", "VoltageLimiter",
-           "step_lockstep", "observe", "tracking_reward"]
+__all__ = ["default_reference", "check_curvature_range", "check_mass_range", "warn_heavy_range", "draw_episode",
+           "VoltageLimiter", "step_lockstep", "observe", "reference_value", "tracking_reward"]
 
 #: the reward at an error of one margin (dm_control's ``rewards.tolerance`` default)
 VALUE_AT_MARGIN = 0.1
@@ -66,12 +66,22 @@ def check_mass_range(bounds) -> Optional[Tuple[float, float]]:
     return lo, hi
 
 
+def warn_heavy_range(payload_mass_range: Optional[Tuple[float, float]], scene, stacklevel: int = 4) -> None:
+    """The Scene's unit check of a payload (:func:`mjeap.simulation.scene.warn_heavy_payload`)
+    on the heaviest mass an episode may draw, once, when the environment is made."""
+    from .simulation.scene import warn_heavy_payload
+    if payload_mass_range is not None:
+        warn_heavy_payload(payload_mass_range[1], float(scene.layout.link_mass.sum()),
+                           "payload_mass_range's upper mass", stacklevel)
+
+
 def draw_episode(scene, random, payload_mass_range: Optional[Tuple[float, float]],
                  initial_curvature_range: Tuple[float, float]) -> Dict[str, float]:
     """Draw an episode from ``random`` (a numpy Generator or RandomState): the payload mass
     uniformly in ``payload_mass_range`` (kg; None: the scene's own, nothing drawn), written
     into ``scene.model`` with its inertia (same sphere, or the same given inertia) and
-    ``mj_setConst``; then the initial curvature (1/m) uniformly in
+    ``mj_setConst``, and into ``scene.payload`` (same position and size: the model simulates
+    the drawn mass, the scene says so); then the initial curvature (1/m) uniformly in
     ``initial_curvature_range``. Returns ``{"payload_mass_kg"?, "initial_curvature_per_m"}``;
     the caller resets the beam and the drive to that curvature."""
     episode = {}
@@ -81,10 +91,12 @@ def draw_episode(scene, random, payload_mass_range: Optional[Tuple[float, float]
                                  "None for a scene without a payload (give the scene a nominal payload)")
         mass = float(random.uniform(*payload_mass_range))
         m, u, p = scene.model, scene.units, scene.payload
+        drawn = Payload(mass, p.position, rotary_inertia=p.rotary_inertia) if p.rotary_inertia is not None else \
+            Payload(mass, p.position, p.sphere_radius)          # the sphere drawn keeps its size
         m.body_mass[scene.payload_id] = mass / u.mass
-        m.body_inertia[scene.payload_id] = (p.rotary_inertia if p.rotary_inertia is not None else
-                                            Payload(mass, p.position, p.sphere_radius).inertia) / u.inertia
+        m.body_inertia[scene.payload_id] = drawn.inertia / u.inertia
         mujoco.mj_setConst(m, scene.data)
+        scene.payload = drawn
         episode["payload_mass_kg"] = mass
     episode["initial_curvature_per_m"] = float(random.uniform(*initial_curvature_range))
     return episode
@@ -133,12 +145,28 @@ def observe(scene, drive, reference: Callable[[float], float], signal_names: Lis
     sig = drive.signals()
     obs = collections.OrderedDict()
     obs["tip_curvature"] = np.array([scene.tip_curvature()])
-    obs["reference"] = np.array([float(reference(scene.time))])
+    obs["reference"] = np.array([reference_value(reference, scene.time)])
     obs["tip_position"] = scene.tip_position()
     obs["drive_state"] = np.array([sig[k] for k in signal_names], dtype=float)
     if "current (A)" in sig:
         obs["current"] = np.array([sig["current (A)"]])
     return obs
+
+
+def reference_value(reference: Callable[[float], float], t: float) -> float:
+    """``reference(t)`` (1/m) as one finite number (a one-element array too); anything else
+    (more values, text, None, NaN) is refused naming the reference and the time."""
+    value = reference(t)
+    try:
+        a = None if isinstance(value, (str, bytes, bool, type(None))) else np.asarray(value, dtype=float)
+    except (TypeError, ValueError):
+        a = None
+    if a is None or a.size != 1 or not np.isfinite(a.reshape(-1)[0]):
+        shown = value if a is None or a.ndim == 0 else f"{type(value).__name__} of shape {a.shape}"
+        raise ParameterError("reference", shown, "a callable reference(t) returning one finite number, the "
+                             "reference curvature in 1/m at t s (a number or an array of shape (1,))",
+                             f"its value at t = {t:.6g} s")
+    return float(a.reshape(-1)[0])
 
 
 def tracking_reward(kappa: float, reference: float, margin: float) -> float:

@@ -15,6 +15,7 @@ screenshot. A PNG per recording, named after it.
 """
 import argparse
 import os
+import signal
 import socket
 import subprocess
 import sys
@@ -35,6 +36,23 @@ def _loaded(state) -> bool:
             and all(t.end is not None for r in state.recordings for t in r.timelines))
 
 
+def _stop(proc, wait: float = 10.0) -> None:
+    """Stop the viewer: ``rerun`` is a wrapper that starts the viewer binary as its child, so
+    the whole process group it leads (a session of its own, :func:`_start`) is signalled:
+    SIGTERM, up to ``wait`` s for the wrapper, then SIGKILL for whatever is left. Stopping
+    the wrapper alone left the viewer (~360 MB) running."""
+    try:
+        os.killpg(proc.pid, signal.SIGTERM)
+        try:
+            proc.wait(wait)
+        except subprocess.TimeoutExpired:
+            pass
+        os.killpg(proc.pid, signal.SIGKILL)
+    except ProcessLookupError:                     # the group is gone
+        pass
+    proc.wait()
+
+
 def _start(size: str, timeout: float, state_dir: str):
     """A headless viewer on a free port, and a client connected to it. The viewer keeps its
     state (the last blueprint of each application) in ``state_dir``, a fresh folder: a
@@ -43,7 +61,8 @@ def _start(size: str, timeout: float, state_dir: str):
     port = _free_port()
     env = {**os.environ, "XDG_DATA_HOME": state_dir, "XDG_CONFIG_HOME": state_dir}
     proc = subprocess.Popen(["rerun", "--headless", "--window-size", size, "--port", str(port),
-                             "--hide-welcome-screen"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env)
+                             "--hide-welcome-screen"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, env=env,
+                            start_new_session=True)      # its own group: _stop reaches the viewer it starts
     t0 = time.monotonic()
     while True:
         try:
@@ -52,7 +71,7 @@ def _start(size: str, timeout: float, state_dir: str):
             return proc, viewer
         except Exception:
             if time.monotonic() - t0 > timeout or proc.poll() is not None:
-                proc.kill()
+                _stop(proc)
                 raise RuntimeError("the headless Rerun viewer did not start (is a Vulkan driver installed? "
                                    "apt-get install mesa-vulkan-drivers)") from None
             time.sleep(0.5)
@@ -83,11 +102,7 @@ def render_one(path, png: Path, size: str = "1600x900", at_time: float = None, t
         viewer.save_screenshot(str(Path(png).resolve()))
         return png
     finally:
-        proc.terminate()
-        try:
-            proc.wait(10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
+        _stop(proc)
         state.cleanup()
 
 

@@ -10,9 +10,8 @@ F31 = 32.0          # Pa m/V, Jafferis 2015 free value (PZTBender2's f31_eff_f)
 
 def stack(act):
     """(t_p, t_cf, E_p, E_cf) of a catalog bimorph, m and Pa."""
-    lay = {l.name: l for l in act.layers}
-    return (lay["pzt-top"].thickness, lay["carbon-fibre"].thickness, lay["pzt-top"].youngs_modulus,
-            lay["carbon-fibre"].youngs_modulus)
+    lay = {l.role: l for l in act.layers}             # the piezo layers are alike
+    return (lay["piezo"].thickness, lay["core"].thickness, lay["piezo"].youngs_modulus, lay["core"].youngs_modulus)
 
 
 def free_deflection(actuator: str, v: float) -> float:

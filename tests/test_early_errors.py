@@ -3,6 +3,7 @@
 function that would start the work is replaced by one that fails the test if called. The
 interrupt tests start a command in a subprocess and stop it a few seconds in."""
 import importlib
+import json
 import os
 import signal
 import subprocess
@@ -45,7 +46,7 @@ def test_a_drive_refuses_an_actuator_it_does_not_apply_to(capsys):
     assert "Traceback" not in err and len(err.strip().splitlines()) == 1
     assert all(w in err for w in ("drive='electrostrictive'", "'terpolymer'", "pvdf-60, pvdf-60-half, pvdf-130",
                                   "its own drive is 'piezo-bimorph'")), err
-    with pytest.raises(ParameterError, match="piezo-bimorph.*'pzt-top' and 'carbon-fibre' layers.*pzt-hamr-large"):
+    with pytest.raises(ParameterError, match="piezo-bimorph.*'piezo' and 'core' layers.*pzt-hamr-large.*trilayer"):
         rollout(Scene("pedot-micro"), "step:1V", 0.01, drive="piezo-bimorph")
     # no defaults for this actuator: the parameters to give are named
     with pytest.raises(ParameterError, match="rc-relaxation.*every parameter given.*missing zero, pole_mechanical"):
@@ -240,10 +241,16 @@ def test_an_interrupted_sweep_stops_its_workers_without_tracebacks(tmp_path):
 
 
 def test_a_terminated_validation_exits_143_with_one_line(tmp_path):
+    """... and its report says it is incomplete and which experiments did not run (on
+    eaac59e it said '0 failed' and validation.json '"passed": true')."""
     code, err, _ = _interrupt([sys.executable, "-m", "mjeap.cli", "validate", "--out", str(tmp_path / "v"), "--quiet"],
                               signal.SIGTERM)
     assert code == 143
     _one_line(err, "SIGTERM")
+    doc = json.loads((tmp_path / "v" / "validation.json").read_text())
+    assert doc["complete"] is False and doc["passed"] is False and doc["not_run"]
+    md = (tmp_path / "v" / "report.md").read_text()
+    assert "INCOMPLETE" in md and doc["not_run"][-1] in md
 
 
 @pytest.mark.parametrize("script,argv", [("hamr_leg.py", []), ("gripper.py", ["--quick"])])

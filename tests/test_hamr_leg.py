@@ -34,14 +34,32 @@ def test_phase_error_within_5_degrees_in_25_cycles(swing):
         assert n is not None and n <= MAX_CYCLES, (which, n)
 
 
+def _sensed_bias(run):
+    """Sensed minus true foot phase error (deg) over the last three open-loop cycles."""
+    n_open = run.open_loop_cycles
+    return run.sensed_error_deg[n_open - 3:n_open] - run.true_error_deg[n_open - 3:n_open]
+
+
 def test_sensed_phase_follows_the_true_phase(swing):
     """The estimator is calibrated on the free actuator and not changed for the leg (as in
     the paper); the leg's inertial tip force bends the actuator differently from the drive's
-    uniform moment, so the sensed phase carries a small bias (about 3 degrees here)."""
+    uniform moment, so the sensed phase carries a small bias (measured 0.9 / 0.7 / 0.6
+    degrees over the last three open-loop cycles; 6.7 / 6.5 / 6.3 when the controller's
+    lock-in dated the current read after a step, which belongs to the step's start, at the
+    step's end: omega h = 5.7 deg at the leg's 159 us step)."""
     run, _ = swing
-    n_open = run.open_loop_cycles
-    bias = run.sensed_error_deg[n_open - 3:n_open] - run.true_error_deg[n_open - 3:n_open]
-    assert np.abs(bias).max() < PHASE_TOL_DEG
+    assert np.abs(_sensed_bias(run)).max() < PHASE_TOL_DEG
+
+
+def test_sensed_phase_bias_converges_with_the_step(swing):
+    """The same open loop at a quarter of the leg's step: the sensed-vs-true bias within
+    0.1 degree of the default step's (measured 0.02; 4.3 degrees apart, 6.6 against 2.3,
+    with the lock-in a step late)."""
+    run, _ = swing
+    quarter = run_leg(SWING, cycles=run.open_loop_cycles + 1, open_loop_cycles=run.open_loop_cycles,
+                      timestep=run.result.meta["scene"]["timestep"] / 4)
+    assert quarter.result.meta["scene"]["timestep"] < run.result.meta["scene"]["timestep"] / 3.9
+    np.testing.assert_allclose(_sensed_bias(quarter), _sensed_bias(run), atol=0.1)
 
 
 def test_gains_from_the_plant_put_both_poles_at_one_half():

@@ -34,12 +34,28 @@ def test_the_legs_moving_mass_is_not_the_cause(d):
 
 def test_the_climb_is_friction_limited(d):
     """On a 12 deg incline at 10 Hz and full drive (upright on level ground), one parameter
-    changed: with the default mu 0.51 the robot slides back down (measured -0.11 m/s along
+    changed: with the default mu 0.51 the robot slides back down (measured -0.12 m/s along
     the slope), with mu 1.2 it climbs (+0.09 m/s); upright in both."""
     low = st.study_run(10.0, build={"mu": hw.MU, "incline_deg": 12.0}, d=d)
     high = st.study_run(10.0, build={"mu": 1.2, "incline_deg": 12.0}, d=d)
     assert low["speed_m_s"] < 0 < high["speed_m_s"]
     assert low["upright"] and high["upright"]
+
+
+def test_at_80_hz_the_gait_not_the_contact_makes_the_body_hop(d):
+    """At 80 Hz, 20 V (the lifts at their resonance) the body flies between landings whatever
+    the contact's time constant (10 steps, the walker's, and 50, five times softer): each
+    foot lands less than once every two cycles (measured 0.23 and 0.25 landings per cycle)
+    and the body never comes down to its hips' height on unloaded legs over the window
+    (FOOT_DROP + FOOT_RADIUS = 11.85 mm; at rest, loaded, 11.56 mm, hamr_walk.stand; its
+    lowest here 15.3 mm). Only the time per landing follows the contact (duty factor 0.0047
+    against 0.016, measured)."""
+    rows = st.contact_study(80.0, 20.0, steps=(hw.CONTACT_STEPS, 5 * hw.CONTACT_STEPS))
+    standing = hw.FOOT_DROP + hw.FOOT_RADIUS        # m, the hips' height on unloaded legs
+    for r in rows:
+        assert r["touchdowns_per_cycle"] < 0.5, r
+        assert r["body_height_range_m"][0] > standing, r
+    assert rows[0]["duty_factor"] < rows[1]["duty_factor"]
 
 
 def test_the_study_options_refuse_bad_values():

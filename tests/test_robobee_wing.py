@@ -55,8 +55,11 @@ def test_stroke_peaks_between_30_and_270_hz_and_is_self_sensed():
     actuator: the motional current is a small part of the total, so the estimate's error
     is the calibrated blocking factor's own error times the dielectric-to-motional current
     ratio there (eq. 7: I_sen = I_mech + (1 - beta) C dV/dt), which the bound adds to the
-    paper's 10 %. Measured: -0.9 / +0.6 / +13 % at the default step, -2.2 / +0.4 / +22 % at a
-    quarter of it (beta from the free actuator's sweep, 1.033 and 1.049)."""
+    paper's 10 %. Measured: -0.15 / +0.79 / +8.4 % at the default step, -0.15 / +0.81 / +8.8 %
+    at a quarter of it (beta from the free actuator's sweep, 1.0217 and 1.0217; the ratio
+    5.0). With the capacitive current and the estimator's dV/dt half a step (sample) before
+    the voltage's instant they were +13 % and +22 % (beta 1.033 and 1.049, and the estimator
+    differencing over its 37 us samples against the drive's step): see mjeap.drives.piezo."""
     from mjeap.analysis.frequency import phasor
     system = robobee.build(100.0)
     est = robobee.estimator(100.0)

@@ -80,9 +80,13 @@ class SineSweep:
 
     @property
     def derivative(self) -> np.ndarray:
-        """The sampled backward difference d/dt as a frequency response, 1/s."""
+        """d/dt of the samples at their own instant as a frequency response, 1/s: the causal
+        second-order difference (3 - 4 exp(-i omega dt) + exp(-2 i omega dt)) / (2 dt), what
+        the piezo drive's capacitive current and the self-sensing estimator take of the
+        voltage (:mod:`mjeap.drives.piezo`)."""
         dt = self.meta["timestep_s"]
-        return (1 - np.exp(-2j * np.pi * self.frequency * dt)) / dt
+        z = np.exp(-2j * np.pi * self.frequency * dt)
+        return (3 - 4 * z + z**2) / (2 * dt)
 
     @property
     def central_derivative(self) -> np.ndarray:

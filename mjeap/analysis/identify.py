@@ -9,9 +9,17 @@
   itself (a :class:`~mjeap.scene.Scene`) being the model.
 * :func:`read_columns`: a user's CSV, checked (columns present, time increasing, finite,
   enough samples) with errors that say what is wrong.
+* :func:`step_actuator`, :func:`hinge_actuator`: an actuator (a user's file) with what was
+  identified put in it, each number's source naming the data file, so that measure,
+  identify, simulate and design are one path (``mjeap identify ... --out identified.toml``):
+  the step fit gives the ``rc-relaxation`` drive's eq. (8) parameters; the hinge fit's joint
+  stiffness k becomes a flexural-rigidity override EI = k ds (ds = L / N, the hinge chain's
+  midpoint rule, :mod:`mjeap.model.discretize`) and its joint damping b the first-mode
+  damping ratio whose Rayleigh damping is b = beta k in the fit's scene.
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Dict, Optional, Sequence, Tuple, Union
@@ -229,3 +237,128 @@ def fit_hinge_parameters(scene, time, tip_deflection, voltage, drive=None, drive
     scene.set_hinge_parameters(stiffness=k, damping=b)
     return HingeFit(float(k), float(b), float(k * sk), float(b * sb),
                     float(np.sqrt(s2) * scale), n_eval[0])
+
+
+# ---------------------------------------------------------------- what was identified, into an actuator
+#: the drive whose parameters a step fit identifies (seed 000, eq. 8)
+STEP_DRIVE = "rc-relaxation"
+#: the identified file must reproduce the fitted tip trajectory to this fraction of its swing
+REPRODUCE = 0.02
+
+
+def file_drive_rows(act, drive: Optional[str], given: Dict[str, tuple]) -> Dict[str, tuple]:
+    """The drive parameter rows (value SI, '', source) of ``act`` driven by ``drive``
+    (default its own): its file's own where it names that drive (another drive's are
+    dropped), ``given`` over them. A name the drive does not take is refused."""
+    from ..drives import default_drive_name, get_drive_class
+    drive = drive or default_drive_name(act)
+    cls = get_drive_class(drive)
+    known = {*cls.parameter_units(), *cls.extra_parameters(None)}
+    for k, v in given.items():
+        if k not in known:
+            raise ParameterError("--param", f"{k}={v[0]}", f"a parameter of the {drive} drive: "
+                                 f"{', '.join(sorted(known)) or 'none'}")
+    own = dict(act.drive_parameters) if (act.drive or default_drive_name(act)) == drive else {}
+    return {**own, **given}
+
+
+def given_rows(params: Optional[dict], how: str) -> Dict[str, tuple]:
+    """Drive parameters given alongside a fit (``--param``) as rows with their source."""
+    return {k: (v, "", f"given on the command line ({how} --param)") for k, v in (params or {}).items()}
+
+
+def step_rows(act, given: Optional[Dict[str, tuple]] = None) -> Dict[str, tuple]:
+    """The rc-relaxation rows ``act`` keeps or is ``given`` besides the four a step fit
+    identifies; raises, before the fit, where the drive would lack one (its capacitance:
+    a curvature step does not identify it)."""
+    from ..drives import get_drive_class
+    rows = file_drive_rows(act, STEP_DRIVE, given or {})
+    fitted = ("gain", "zero", "pole_mechanical", "pole_electrical")
+    missing = [k for k in get_drive_class(STEP_DRIVE).parameter_units() if k not in rows and k not in fitted]
+    if missing:
+        where = act.source_file or act.id
+        raise ParameterError(f"{where}: drive.parameters.{missing[0]}", "missing",
+                             f"a value for the {STEP_DRIVE} drive's {', '.join(missing)} (a curvature step does not "
+                             f"identify it): in the file's [drive.parameters], or --param {missing[0]}=VALUE",
+                             f"the file's drive is {act.drive or 'not named'}" if act.drive != STEP_DRIVE else "")
+    return rows
+
+
+def step_actuator(act, fit: StepFit, data: str, given: Optional[Dict[str, tuple]] = None):
+    """``act`` driven by the rc-relaxation drive with the eq. (8) parameters of ``fit``, each
+    sourced to the ``data`` file it was identified from; the drive's other parameters the
+    file's own (same drive) or ``given``. The initial curvature is a state, not written."""
+    rows = step_rows(act, given)
+    how = (f"identified from {data} (mjeap identify step: seed 000 eqs. 7-8 fitted to a {fit.voltage:g} V step, "
+           f"rms residual {fit.rms_residual:.3g} 1/m)")
+    fitted = {k: (float(v), "", how) for k, v in fit.drive_parameters().items()}
+    rows = {**fitted, **{k: v for k, v in rows.items() if k not in fitted}}
+    return dataclasses.replace(act, drive=STEP_DRIVE, drive_parameters=rows, notes=_noted(act, data, "step"))
+
+
+def _noted(act, data: str, what: str) -> str:
+    line = f"identified from {data} by mjeap identify {what}"
+    return f"{act.notes}; {line}" if act.notes else line
+
+
+def hinge_actuator(scene, fit: HingeFit, data: str, drive: Optional[str] = None,
+                   given: Optional[Dict[str, tuple]] = None):
+    """``scene.actuator`` with the hinge fit put in it (sources naming ``data``):
+    flexural_rigidity EI = k ds (every hinge k = EI / ds, ds = L / N: the chain's midpoint
+    rule, uniform along the beam as the fit is) and the damping ratio whose first-mode
+    Rayleigh damping in the fit's scene gives the fitted joint damping, beta = b / k (plus
+    the timestep 'discrete' adds itself); driven by ``drive`` (default its own) with
+    ``given`` over its parameters."""
+    from ..drives import default_drive_name
+    from ..model.actuator import Sourced
+    act = scene.actuator
+    drive = drive or default_drive_name(act)
+    n, ds = scene.layout.segments, scene.layout.ds
+    how = f"identified from {data} (mjeap identify hinges: seed 001's joint fit on {n} hinges"
+    EI = Sourced(fit.stiffness * ds, "N m^2",
+                 f"{how}, k = {fit.stiffness:.4g} +- {fit.stiffness_std:.2g} N m/rad at every hinge; EI = k L/N, "
+                 "uniform along the beam)")
+    new = dataclasses.replace(act, flexural_rigidity=EI, drive=drive, notes=_noted(act, data, "hinges"),
+                              drive_parameters=file_drive_rows(act, drive, given or {}))
+    beta = fit.damping / fit.stiffness + scene.choice.integrator_beta
+    zeta = beta / _beta_per_damping_ratio(scene, new)
+    if not 0.0 < zeta < 1.0:
+        raise ParameterError("damping_ratio", f"{zeta:.4g} (identified: b = {fit.damping:.4g} N m s/rad, "
+                             f"k = {fit.stiffness:.4g} N m/rad)", "a first-mode damping ratio in (0, 1), as an "
+                             "actuator file takes it", "the fitted joint damping is outside what the file can hold; "
+                             "check the data's time base and units")
+    return dataclasses.replace(new, damping_ratio=Sourced(
+        zeta, "-", f"{how}, b = {fit.damping:.4g} +- {fit.damping_std:.2g} N m s/rad at every hinge: the first-mode "
+                   f"damping ratio of Rayleigh damping beta = b/k = {beta:.4g} s in the fit's scene "
+                   f"({scene.representation}, {scene.orientation}, {'payload, ' if scene.payload else ''}"
+                   f"{scene.integrator}))"))
+
+
+def _scene_like(scene, act, **kw):
+    """A Scene of ``act`` built as ``scene`` is (representation, segments, orientation,
+    payload, units, gravity, integrator), ``kw`` over it."""
+    from ..simulation.scene import Scene
+    a = scene._arguments
+    args = dict(representation=a["representation"], segments=scene.layout.segments, orientation=a["orientation"],
+                payload=a["payload"], units=a["units"], gravity=a["gravity"], integrator=scene.integrator)
+    return Scene(act, **{**args, **kw})
+
+
+def _beta_per_damping_ratio(scene, act) -> float:
+    """The Rayleigh beta (s) per unit first-mode damping ratio of ``act`` built as ``scene``
+    (beta = 2 zeta w1 / k1 is linear in zeta: the probe is built at zeta = 1)."""
+    return _scene_like(scene, act, damping_ratio=1.0).choice.rayleigh_beta
+
+
+def reproduction_error(scene, fit: HingeFit, act, time, voltage, drive=None, drive_params=None) -> Tuple[float, float]:
+    """(rms difference, swing) in m between the tip trajectory of ``scene`` with the fitted
+    hinges and that of ``act`` alone (its file's drive and parameters), built as ``scene``
+    is but with its own timestep, under ``voltage`` at ``time``: whether a file holds what
+    was fitted."""
+    from ..simulation.rollout import rollout
+    t = np.asarray(time, float)
+    duration = float(t[-1]) + scene.timestep
+    fitted = simulate_tip(scene, fit.stiffness, fit.damping, voltage, duration, t, drive, drive_params)
+    r = rollout(_scene_like(scene, act), voltage, duration, progress=False)
+    mine = np.interp(t, r.time, r.tip_position[:, 1])
+    return float(np.sqrt(np.mean((mine - fitted) ** 2))), float(np.ptp(fitted))

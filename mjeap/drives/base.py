@@ -19,15 +19,33 @@ import mujoco
 import numpy as np
 from scipy import signal
 
-from ..errors import ParameterError, UnknownNameError
+from ..errors import ParameterError, UnknownNameError, check_registration
 
 DRIVES: Dict[str, Type["Drive"]] = {}
 
 
-def register_drive(cls: Type["Drive"]) -> Type["Drive"]:
-    """Class decorator: make a :class:`Drive` subclass available by its ``name``."""
-    if not getattr(cls, "name", ""):
-        raise ParameterError("Drive.name", getattr(cls, "name", None), "a non-empty string")
+def _drive_lacks(cls) -> Optional[str]:
+    """Why ``cls`` cannot be registered as a drive (None: it can)."""
+    if not isinstance(cls, type) or not issubclass(cls, Drive):
+        return "an instance, not the class: register_drive(MyDrive)" if isinstance(cls, Drive) else "not a Drive"
+    if cls.step is Drive.step:
+        return "its step is Drive.step's, which applies no moment"
+    if not isinstance(cls.actuators, (tuple, list)) or not all(isinstance(a, str) for a in cls.actuators):
+        return f"its actuators is {cls.actuators!r}, not a tuple of catalog ids"
+    if not isinstance(cls.PARAMETERS, dict) or not isinstance(cls.GENERIC_PARAMETERS, dict):
+        return "its PARAMETERS or GENERIC_PARAMETERS is not a dict"
+    return None
+
+
+def register_drive(cls: Optional[Type["Drive"]] = None, *, replace: bool = False):
+    """Class decorator: make a :class:`Drive` subclass (one that implements
+    :meth:`Drive.step`) available by its ``name`` (letters, digits, '-', '_'). A name taken
+    is refused unless ``replace`` (``@register_drive(replace=True)``)."""
+    if cls is None:
+        return lambda c: register_drive(c, replace=replace)
+    check_registration("drive", DRIVES, getattr(cls, "name", None), cls, lacks=_drive_lacks(cls),
+                       expected="a subclass of mjeap.Drive that implements step, with a name",
+                       replace=replace, how="register_drive")
     DRIVES[cls.name] = cls
     return cls
 
@@ -39,17 +57,28 @@ def get_drive_class(name: str) -> Type["Drive"]:
         raise UnknownNameError("drive", str(name), DRIVES) from None
 
 
-def default_drive_name(actuator_id: str) -> str:
-    """The drive whose source document describes this catalog actuator."""
+def default_drive_name(actuator) -> str:
+    """The actuator's own drive: the one its file names (an :class:`~mjeap.Actuator` or an
+    actuator file's path), or for a catalog id the drive whose source document describes it."""
+    from ..model.actuator_file import is_actuator_file
+    from ..model.catalog import CATALOG, get_actuator
+    if is_actuator_file(actuator):
+        actuator = get_actuator(actuator)
+    if not isinstance(actuator, str):
+        if getattr(actuator, "drive", None):
+            return actuator.drive
+        actuator = actuator.id
+    if actuator in CATALOG and CATALOG[actuator].drive:
+        return CATALOG[actuator].drive
     for cls in DRIVES.values():
-        if actuator_id in cls.actuators:
+        if actuator in cls.actuators:
             return cls.name
-    raise UnknownNameError("drive for actuator", actuator_id, DRIVES)
+    raise UnknownNameError("drive for actuator", actuator, DRIVES)
 
 
 def make_drive(name: Optional[str], scene, **params) -> "Drive":
     """Instantiate the drive ``name`` (default: the actuator's own) for ``scene``."""
-    name = name or default_drive_name(scene.actuator.id)
+    name = name or default_drive_name(scene.actuator)
     return get_drive_class(name)(scene, **params)
 
 
@@ -105,37 +134,43 @@ class ExactLTI:
 
 class Drive:
     """A drive stepped with the beam (what the loop engine needs): subclasses set ``name``,
-    ``actuators`` (catalog ids the source describes), ``PARAMETERS`` (per actuator:
-    defaults with their sources) and implement :meth:`reset` and :meth:`step`. What the
-    other engines need is mixed in: :class:`OpenLoop` (threaded), :class:`NativeForm`
-    (native, systems)."""
+    ``actuators`` (catalog ids the source describes), ``GENERIC_PARAMETERS`` (defaults with
+    their sources; an actuator file's [drive.parameters] override them), ``UNITS`` (the
+    units of parameters without a generic default), ``ROLES`` (the layer roles the drive
+    reads) and implement :meth:`reset` and :meth:`step`. What the other engines need is
+    mixed in: :class:`OpenLoop` (threaded), :class:`NativeForm` (native, systems)."""
 
     name: ClassVar[str] = ""
     actuators: ClassVar[Tuple[str, ...]] = ()
+    #: per catalog id: defaults with their sources (a user drive's; the built-in drives'
+    #: per-actuator values live in the actuators' files)
     PARAMETERS: ClassVar[Dict[str, Dict[str, Tuple[float, str, str]]]] = {}
-    #: defaults for an actuator the source does not describe (a user's own), same layout
+    #: defaults for an actuator whose file gives none: (value SI, unit, source)
     GENERIC_PARAMETERS: ClassVar[Dict[str, Tuple[float, str, str]]] = {}
+    #: units of the parameters that have no generic default (every one must then be given)
+    UNITS: ClassVar[Dict[str, str]] = {}
     #: accepted (low, high) of numeric parameters, open bounds; every numeric one must be finite
     RANGES: ClassVar[Dict[str, Tuple[float, float]]] = {}
-    #: names of the layers the drive's physics reads (an actuator without them is refused,
-    #: naming the actuators the drive applies to)
-    LAYERS: ClassVar[Tuple[str, ...]] = ()
+    #: layer roles the drive's physics reads and how many of each (an actuator without them
+    #: is refused, naming the roles); :meth:`stack_reason` may ask more of the stack
+    ROLES: ClassVar[Dict[str, int]] = {}
     model_used: str = ""
 
     def __init__(self, scene, **params):
         self.scene = scene
         # the actuator the drive acts on: a Scene's one part, or a part of a System
         self.part = getattr(scene, "part", scene)
-        self._check_actuator(scene.actuator)
-        defaults = self.PARAMETERS.get(scene.actuator.id, self.GENERIC_PARAMETERS)
-        known = self._parameter_table()
-        if not defaults and known:      # no defaults for this actuator: every parameter must be given
-            missing = [k for k in known if k not in params]
-            if missing:
-                raise ParameterError("drive", self.name,
-                                     f"a drive for {', '.join(self.PARAMETERS)} (those it has defaults for), or every "
-                                     f"parameter given: {', '.join(known)}",
-                                     f"{scene.actuator.id} has no defaults; missing {', '.join(missing)}")
+        act = scene.actuator
+        self._check_actuator(act)
+        defaults = self.defaults_for(act)
+        known = self.parameter_units()
+        missing = [k for k in known if k not in defaults and k not in params]
+        if missing:
+            where = f" ({act.source_file})" if getattr(act, "source_file", None) else ""
+            raise ParameterError("drive", self.name,
+                                 f"every parameter given: {', '.join(known)} (an actuator file's [drive.parameters], "
+                                 "or drive_params)",
+                                 f"{act.id}{where} has no value for them; missing {', '.join(missing)}")
         self.params = {k: v[0] for k, v in defaults.items()}
         self.sources = {k: f"{v[1]}; {v[2]}" for k, v in defaults.items()}
         for k, v in params.items():
@@ -145,34 +180,61 @@ class Drive:
             self.sources[k] = "given by the user"
         self._check_parameters()
 
+    @classmethod
+    def parameter_units(cls) -> Dict[str, str]:
+        """Every parameter the drive takes, with its unit."""
+        out = {k: row[1] for table in cls.PARAMETERS.values() for k, row in table.items()}
+        out.update({k: row[1] for k, row in cls.GENERIC_PARAMETERS.items()})
+        out.update(cls.UNITS)
+        return out
+
+    @classmethod
+    def defaults_for(cls, actuator) -> Dict[str, Tuple[float, str, str]]:
+        """The parameter defaults for ``actuator``: its file's [drive.parameters] over the
+        generic ones where the file names this drive, else those of a user drive's
+        ``PARAMETERS`` for its id, else the generic ones."""
+        if getattr(actuator, "drive", None) == cls.name and actuator.drive_parameters:
+            units = cls.parameter_units()
+            return {**cls.GENERIC_PARAMETERS,
+                    **{k: (v[0], units.get(k, v[1]), v[2]) for k, v in actuator.drive_parameters.items()}}
+        return cls.PARAMETERS.get(actuator.id, cls.GENERIC_PARAMETERS)
+
+    @classmethod
+    def stack_reason(cls, actuator) -> Optional[str]:
+        """Why this drive cannot take ``actuator``'s layer stack (None: it can): by default,
+        a role of :attr:`ROLES` missing or present too few times."""
+        roles = [l.role for l in actuator.layers]
+        short = [f"{n} '{r}'" for r, n in cls.ROLES.items() if roles.count(r) < n]
+        if not short:
+            return None
+        return (f"it needs {', '.join(short)} layer{'s' if sum(cls.ROLES.values()) > 1 else ''} (role = ...); "
+                f"{actuator.id} has " + ", ".join(f"{l.name} ({l.role or 'no role'})" for l in actuator.layers))
+
     def _check_actuator(self, actuator) -> None:
-        """Refuse an actuator without the layers the drive reads (:attr:`LAYERS`)."""
-        names = [l.name for l in actuator.layers]
-        missing = [n for n in self.LAYERS if n not in names]
-        if not missing:
+        """Refuse an actuator whose layer stack the drive cannot take (:meth:`stack_reason`)."""
+        why = self.stack_reason(actuator)
+        if why is None:
             return
         try:
-            own = f"; its own drive is '{default_drive_name(actuator.id)}'"
+            own = f"; its own drive is '{default_drive_name(actuator)}'"
         except UnknownNameError:
             own = ""
-        layers = " and ".join(f"'{n}'" for n in self.LAYERS)
+        roles = " and ".join(f"'{r}'" for r in self.ROLES)
         raise ParameterError("drive", self.name,
-                             f"a drive for an actuator with {layers} layer{'s' if len(self.LAYERS) > 1 else ''} "
-                             f"(in the catalog: {', '.join(self.actuators)})",
-                             f"{actuator.id} has layers {', '.join(names)}{own}")
+                             f"a drive for an actuator with {roles} layer{'s' if len(self.ROLES) > 1 else ''} "
+                             f"(in the catalog: {', '.join(self.actuators) or 'none'})", f"{why}{own}")
 
     def _parameter_table(self) -> Dict[str, Tuple[float, str, str]]:
-        """The parameters this drive takes, with their defaults for this actuator, or the
-        first described actuator's (their types) where it has none."""
-        return (self.PARAMETERS.get(self.scene.actuator.id) or self.GENERIC_PARAMETERS
-                or next(iter(self.PARAMETERS.values()), {}))
+        """The parameters this drive takes for this actuator, with their defaults."""
+        return self.defaults_for(self.scene.actuator)
 
     def _check_parameters(self) -> None:
         """Every parameter that defaults to a number must be a finite number, within RANGES."""
         table = self._parameter_table()
         for k, v in self.params.items():
             default = table.get(k, (None,))[0]
-            if not isinstance(default, (int, float)) or isinstance(default, bool):
+            numeric = isinstance(default, (int, float)) and not isinstance(default, bool)
+            if not numeric and not (k not in table and k in self.UNITS):   # a choice, a switch, a table
                 continue
             if isinstance(v, bool) or not isinstance(v, (int, float, np.number)) or not np.isfinite(v):
                 raise ParameterError(f"{self.name} parameter {k}", v, "a finite number")

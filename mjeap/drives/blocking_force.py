@@ -42,11 +42,11 @@ class BlockingForceDrive(OpenLoop, NativeForm, Drive):
     name = "blocking-force"
     actuators = ("ppy-trilayer",)
     model_used = "uniform moment (2/3) F_B L from a first-order blocking force"
-    PARAMETERS = {"ppy-trilayer": {
+    #: the ppy-trilayer's values (also in its actuator file), the defaults for any actuator
+    GENERIC_PARAMETERS = {
         "blocking_force_per_volt": (0.5e-3, "N/V", _EST),
         "time_constant": (2.0, "s", "estimate (PPy trilayers of this size settle in seconds; not extractable from seed 001)"),
-    }}
-    GENERIC_PARAMETERS = PARAMETERS["ppy-trilayer"]
+    }
     RANGES = {"time_constant": (0.0, np.inf)}
 
     def extra_parameters(self):

@@ -77,21 +77,14 @@ def eigenstrain_moment(actuator, strain: float) -> float:
 
 def active_layer(actuator) -> int:
     """Index of the terpolymer layer in the stack."""
-    return next(k for k, l in enumerate(actuator.layers) if l.name == "terpolymer")
+    return next(k for k, l in enumerate(actuator.layers) if l.role == "terpolymer")
 
 
 @register_drive
 class ElectrostrictiveDrive(OpenLoop, Drive):
     name = "electrostrictive"
     actuators = ("pvdf-60", "pvdf-60-half", "pvdf-130")
-    LAYERS = ("terpolymer",)
-    PARAMETERS = {a: {"strain_coefficient": (STRAIN_COEFFICIENT, "m^2/V^2", _Q),
-                      "relative_permittivity": (45.0, "-", f"{_T}, Table 5.2 (dielectric constant; model='maxwell')"),
-                      "model": ("eigenstrain", "-", "electrostrictive eigenstrain S = Q E^2 (or 'maxwell', thesis "
-                                                     "eqs. 3.7-3.11)"),
-                      "stiffening": (False, "-", f"{_T}, Tables 4.1-4.4: empirical slopes against field, not "
-                                                 "physics; off by default")}
-                  for a in ("pvdf-60", "pvdf-60-half", "pvdf-130")}
+    ROLES = {"terpolymer": 1}
     GENERIC_PARAMETERS = {"strain_coefficient": (STRAIN_COEFFICIENT, "m^2/V^2", _Q),
                           "relative_permittivity": (45.0, "-", f"{_T}, Table 5.2 (terpolymer dielectric constant)"),
                           "model": ("eigenstrain", "-", "electrostrictive eigenstrain S = Q E^2"),

@@ -40,6 +40,23 @@ sum_j Gamma_j (v_j,k + v_j,k+1) / 2, the rates before and after the step the vol
 over; every engine reads it so (the threaded and native ones replay the step from the state
 before it). ``tests/test_piezo_power.py`` checks power and phase at 0.3 .. 2 f_1 against
 converged runs and the per-cycle energy balance.
+
+The instant of C dV/dt. The capacitive current belongs to the same instant t_k as V_k and
+I_mech: the causal second-order difference (3 V_k - 4 V_{k-1} + V_{k-2}) / 2h, the slope at
+t_k of the parabola through the last three voltages (its phase error is (omega h)^3 / 4, its
+magnitude error (omega h)^2 / 3). The backward difference (V_k - V_{k-1}) / h is the slope at
+t_k - h/2: beside I_mech at t_k it lagged by omega h / 2 (5.6 deg at 2 kHz on the RoboBee
+actuator's 15.6 us step), which shows wherever the motional current is a small part of the
+total: the fitted blocking factor of eq. 8 moved with the step (pzt-robobee's sweep to 2 f_1:
+1.033 at h, 1.049 at h/4, 1.056 at h/16; now 1.0589 and 1.0593 at h and h/4) and a blocked
+actuator's self-sensed stroke with it. Its real part omega^2 h / 2 also made the capacitor
+do work over a cycle, 24 % of the motional power at f_1 / 2 on pzt-hamr-small (now 3e-4:
+the second-order difference's real part is omega^4 h^3 / 4). Before the first step the first voltage is taken as
+held (no current). The charge of a voltage step, sum_k h I_C,k = C (3/2 - 1/2) Delta V, is
+C Delta V as with the backward difference, delivered over two steps (3/2 then -1/2 of it:
+the parabola's slope overshoots a jump; tests/test_piezo_power.py). A self-sensing
+estimator must difference its own voltage samples the same way
+(:mod:`mjeap.controllers.self_sensing`) for beta C_fit = C to cancel the dielectric current.
 """
 from __future__ import annotations
 
@@ -69,8 +86,9 @@ class PiezoBimorphDrive(OpenLoop, NativeForm, Drive):
     name = "piezo-bimorph"
     actuators = ("pzt-hamr-large", "pzt-hamr-small", "pzt-robobee")
     model_used = "unipolar simultaneous drive, Wood/Jafferis effective stress"
-    LAYERS = ("pzt-top", "carbon-fibre")
-    PARAMETERS = {"pzt-hamr-large": _params(45.5), "pzt-hamr-small": _params(32.2), "pzt-robobee": _params(10.1)}
+    #: a core with a piezo layer of equal thickness either side (:meth:`stack_reason`);
+    #: the catalog bimorphs' parameters are in their actuator files
+    ROLES = {"piezo": 2, "core": 1}
     GENERIC_PARAMETERS = _params(32.2)
     RANGES = {"bias": (0.0, 200.0 + 1e-9), "f31": (0.0, np.inf), "capacitance": (0.0, np.inf),
               "resistance": (0.0, np.inf)}
@@ -78,16 +96,38 @@ class PiezoBimorphDrive(OpenLoop, NativeForm, Drive):
     def __init__(self, scene, **params):
         super().__init__(scene, **params)
         act = scene.actuator
-        names = [l.name for l in act.layers]
-        self.t_p = act.layers[names.index("pzt-top")].thickness
-        self.t_cf = act.layers[names.index("carbon-fibre")].thickness
+        self.t_p, self.t_cf = self.stack(act)
         w = scene.layout.hinge_width
         self.gamma = self.params["f31"] * w * (self.t_p + self.t_cf)   # N m / V per hinge (module text)
-        self._v_prev = None
+        self._v_prev = self._v_prev2 = None     # the voltages held over the last two steps, V
         self._v = self._dv = 0.0
         self._m = np.zeros(scene.layout.segments)
         self._rates = np.zeros(scene.layout.segments)
         self._i_before = None                   # Gamma . (hinge rates before the last step), A
+
+    @staticmethod
+    def stack(actuator):
+        """(t_p, t_cf) (m): a piezo layer's and the core's thickness of a symmetric bimorph."""
+        roles = [l.role for l in actuator.layers]
+        return actuator.layers[roles.index("piezo")].thickness, actuator.layers[roles.index("core")].thickness
+
+    @classmethod
+    def stack_reason(cls, actuator):
+        """The bimorph's stack: exactly one 'core' layer with one 'piezo' layer of equal
+        thickness either side of it (the moment per volt and the closed forms assume it)."""
+        why = super().stack_reason(actuator)
+        if why is not None:
+            return why
+        roles = [l.role for l in actuator.layers]
+        core = [i for i, r in enumerate(roles) if r == "core"]
+        piezo = [i for i, r in enumerate(roles) if r == "piezo"]
+        layers = ", ".join(f"{l.name} ({l.role or 'no role'})" for l in actuator.layers)
+        if len(core) != 1 or len(piezo) != 2 or not piezo[0] < core[0] < piezo[1]:
+            return f"it needs one 'core' layer between two 'piezo' layers; {actuator.id} has {layers}"
+        t1, t2 = (actuator.layers[i].thickness for i in piezo)
+        if abs(t1 - t2) > 1e-9 * max(t1, t2):
+            return f"its two 'piezo' layers must be equally thick (a symmetric bimorph); they are {t1:g} and {t2:g} m"
+        return None
 
     def voltage_range(self):
         return (0.0, float(self.params["bias"]))
@@ -97,7 +137,7 @@ class PiezoBimorphDrive(OpenLoop, NativeForm, Drive):
         return 0.5 * self.params["bias"]
 
     def reset(self, initial_curvature: float = 0.0) -> None:
-        self._v_prev = None
+        self._v_prev = self._v_prev2 = None
         self._v = self.rest_voltage()
         self._dv = 0.0
         self.part.set_internal_moments(0.0)
@@ -107,10 +147,17 @@ class PiezoBimorphDrive(OpenLoop, NativeForm, Drive):
     def step(self, voltage: float, dt: float) -> None:
         np.multiply(self.gamma, voltage - 0.5 * self.params["bias"], out=self._m)
         self.part.set_internal_moments(self._m)
-        self._dv = 0.0 if self._v_prev is None else (voltage - self._v_prev) / dt
+        # dV/dt at the held voltage's instant t_k (module text): before the first step the
+        # first voltage is taken as held
+        if self._v_prev is None:
+            self._dv, self._v_prev2 = 0.0, voltage
+        else:
+            vpp = self._v_prev if self._v_prev2 is None else self._v_prev2
+            self._dv = (1.5 * voltage - 2.0 * self._v_prev + 0.5 * vpp) / dt
+            self._v_prev2 = self._v_prev
         self._v = self._v_prev = voltage
         # the rates the held voltage starts from: half of the motional current's central rate
-        self._i_before = float(self.gamma @ self.part.hinge_rates(self._rates))
+        self._i_before = float(np.dot(self.gamma, self.part.hinge_rates(self._rates)))
 
     def closed_loop_reason(self):
         return None
@@ -139,14 +186,16 @@ class PiezoBimorphDrive(OpenLoop, NativeForm, Drive):
 
     def _restore_before(self, k: int) -> None:
         self._v_prev = None if k == 0 else float(self._v_history[k - 1])
+        self._v_prev2 = None if k == 0 else float(self._v_history[max(k - 2, 0)])
 
     def currents(self):
         """(resistive, capacitive, motional) current of eq. (1), A, of the voltage held over
-        the last step: that voltage, its backward difference over the step (what a sampled
-        dV/dt sees) and the hinges' central rate at the voltage's instant, the mean of their
-        rates before and after the step (module text; before any step, the rates now)."""
+        the last step, all at that voltage's instant t_k: the voltage, C times its causal
+        second-order difference (3 V_k - 4 V_{k-1} + V_{k-2}) / 2h, and the hinges' central
+        rate, the mean of their rates before and after the step (module text; before any
+        step, the rates now)."""
         vb = self.params["bias"]
-        now = float(self.gamma @ self.part.hinge_rates(self._rates))
+        now = float(np.dot(self.gamma, self.part.hinge_rates(self._rates)))
         i_mech = now if self._i_before is None else 0.5 * (self._i_before + now)
         return ((2 * self._v - vb) / (2 * self.params["resistance"]), self.params["capacitance"] * self._dv, i_mech)
 

@@ -37,13 +37,10 @@ class RCRelaxationDrive(NativeForm, Drive):
     name = "rc-relaxation"
     actuators = ("pedot-micro",)
     model_used = "lumped RC + standard-linear-solid back-relaxation"
-    PARAMETERS = {"pedot-micro": {
-        "gain": (_EQ8.k_tf, "1/(m s)", _SRC),
-        "zero": (_EQ8.zero, "1/s", _SRC + "; mechanical zero"),
-        "pole_mechanical": (_EQ8.pole, "1/s", _SRC + "; mechanical pole"),
-        "pole_electrical": (_EQ8.electrical_pole, "1/s", _SRC + "; electrical pole 1/RC"),
-        "capacitance": (1e-3, "F", "assumed (not in the source); only scales the reported charge and current"),
-    }}
+    #: the eq. (8) parameters and their units; seed 000's identified values are in
+    #: pedot-micro's actuator file (mjeap/model/actuators/pedot-micro.toml). No generic
+    #: default: an actuator of one's own gives its own (identify them: mjeap identify step)
+    UNITS = {"gain": "1/(m s)", "zero": "1/s", "pole_mechanical": "1/s", "pole_electrical": "1/s", "capacitance": "F"}
 
     RANGES = {"zero": (0.0, np.inf), "pole_mechanical": (0.0, np.inf), "pole_electrical": (0.0, np.inf),
               "capacitance": (0.0, np.inf)}

@@ -19,23 +19,123 @@ is one module that calls :func:`register_engine`.
 """
 from __future__ import annotations
 
-from typing import Dict, List, Tuple
+from typing import Dict, List, Sequence, Tuple
 
-from ..errors import ParameterError
+import numpy as np
+
+from ..errors import ParameterError, check_registration
 from .base import Engine
+from .frame import Decided
 
 __all__ = ["Engine", "register_engine", "get_engine", "engine_names", "choose", "choose_system", "stepper",
-           "ENGINES"]
+           "run_checked", "run_system_checked", "check_samples", "ENGINES"]
 
 
 _REGISTRY: Dict[str, Engine] = {}
 
 
-def register_engine(engine: Engine) -> Engine:
-    """Add ``engine`` under its name; :func:`choose`'s ``auto`` tries engines in the order
-    they were registered."""
+def _engine_lacks(engine):
+    """Why ``engine`` cannot be registered (None: it can)."""
+    if isinstance(engine, type):
+        return ("a class, not an instance: register_engine(MyEngine())" if issubclass(engine, Engine)
+                else "not an Engine")
+    if not isinstance(engine, Engine):
+        return "not an instance of an Engine subclass"
+    own = [m for m in ("run", "run_system", "advance") if getattr(type(engine), m) is not getattr(Engine, m)]
+    if not own:
+        return "it implements none of run, run_system and advance: it runs nothing"
+    if "run" not in own and type(engine).why_not is Engine.why_not:
+        return "it has no run, yet its why_not (Engine's) says it applies to every run"
+    if not isinstance(engine.batched, bool):
+        return f"its batched is {engine.batched!r}, not a bool"
+    return None
+
+
+def register_engine(engine: Engine, *, replace: bool = False) -> Engine:
+    """Add ``engine`` (an instance of an :class:`Engine` subclass that implements
+    :meth:`Engine.run`, :meth:`Engine.run_system` or :meth:`Engine.advance`) under its name
+    (letters, digits, '-', '_'; not ``auto``); :func:`choose`'s ``auto`` tries engines in
+    the order they were registered. A name taken is refused unless ``replace`` (the
+    replacement keeps its place in that order)."""
+    global ENGINES
+    check_registration("engine", _REGISTRY, getattr(engine, "name", None), engine, lacks=_engine_lacks(engine),
+                       expected="an instance of an mjeap.engines.Engine subclass that implements run, run_system "
+                       "or advance, with a name", reserved=("auto",), replace=replace, how="register_engine")
     _REGISTRY[engine.name] = engine
+    ENGINES = ("auto", *_REGISTRY)
     return engine
+
+
+def _refuse_run(engine: Engine, fault: str):
+    """The ParameterError of an engine that broke its run's contract (``fault``, in words)."""
+    return ParameterError("engine", engine.name, "an engine whose run takes every planned sample (fewer only where "
+                          "a Decided stops it early), in order, of finite times, voltages and positions", fault)
+
+
+def _samples_fault(smp, stopped_early: bool = False):
+    """What is wrong with a sample store (:class:`mjeap.engines.frame.Samples`) after a run
+    (None: nothing): too few samples, arrays of the wrong shape, non-finite values."""
+    n, ns = smp.n, smp.ns
+    if not isinstance(n, (int, np.integer)) or not (1 <= n <= ns if stopped_early else n == ns):
+        return f"it took {n!r} of the {ns} planned samples" + (" before it stopped early" if stopped_early else "")
+    points = smp._bodies.size + 1 + (smp.part.payload_id >= 0)       # clamp, links, tip[, payload]
+    arrays = {"times": (smp.t, (ns,)), "voltages": (smp.v, (ns,)), "positions": (smp._raw, (ns, points, 3)),
+              "orientations": (smp._xmat, (ns, 9))}
+    if smp._clamp_xmat is not None:
+        arrays["clamp orientations"] = (smp._clamp_xmat, (ns, 9))
+    wrong = [f"{k} of shape {np.shape(a)}, not {want}" for k, (a, want) in arrays.items() if np.shape(a) != want]
+    wrong += [f"signal {k!r} of shape {np.shape(x)}, not ({n},) or longer"        # (n,): the native engine's
+              for k, x in (smp.sig or {}).items() if np.ndim(x) != 1 or len(x) < n]
+    if wrong:
+        return "it left " + "; ".join(wrong)
+    bad = [k for k, (a, _) in arrays.items() if not np.isfinite(a[:n]).all()]
+    return f"it left non-finite {', '.join(bad)} in its {n} samples" if bad else None
+
+
+def check_samples(engine: Engine, samples: Sequence, stopped_early: bool = False) -> None:
+    """Refuse, naming ``engine``, sample stores its run left broken (:func:`_samples_fault`;
+    ``stopped_early``: a :class:`Decided` ended the run, so fewer samples are fine). The
+    stores of a refused run are emptied (``n = 0``): no result is built from them."""
+    for b, smp in enumerate(samples):
+        fault = _samples_fault(smp, stopped_early)
+        if fault is not None:
+            for emptied in samples:
+                emptied.n = 0
+            raise _refuse_run(engine, (f"run {b + 1} of {len(samples)}: " if len(samples) > 1 else "") + fault)
+
+
+def run_checked(engine: Engine, scene, drives: Sequence, v_steps: Sequence, initial_curvatures: Sequence[float],
+                sample_steps, samples: Sequence, **kw) -> None:
+    """``engine.run(...)`` (:meth:`Engine.run`), then its samples checked (:func:`check_samples`):
+    a plug-in engine that fills too few samples or non-finite ones is refused naming it,
+    not returned as an empty or NaN result. A :class:`Decided` goes on up."""
+    try:
+        engine.run(scene, drives, v_steps, initial_curvatures, sample_steps, samples, **kw)
+    except Decided:
+        check_samples(engine, samples, stopped_early=True)
+        raise
+    check_samples(engine, samples)
+
+
+def run_system_checked(engine: Engine, system, n_steps: int, sample_steps, before, sample, check) -> None:
+    """``engine.run_system(...)`` (:meth:`Engine.run_system`) with its sampling checked: a
+    plug-in engine that skips, repeats or reorders a planned sample is refused naming it,
+    and the state is checked (``check``) at every sample, so none is non-finite."""
+    taken = 0
+
+    def in_order(i, k):
+        nonlocal taken
+        due = (taken, int(sample_steps[taken])) if taken < len(sample_steps) else None
+        if (i, k) != due:
+            raise _refuse_run(engine, f"it took sample {i} after step {k}; due: " +
+                              ("none" if due is None else f"sample {due[0]} after step {due[1]}"))
+        check(k, k - 1)
+        sample(i, k)
+        taken += 1
+
+    engine.run_system(system, n_steps, sample_steps, before, in_order, check)
+    if taken != len(sample_steps):
+        raise _refuse_run(engine, f"it took {taken} of the {len(sample_steps)} planned samples")
 
 
 def engine_names() -> List[str]:

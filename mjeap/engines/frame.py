@@ -22,7 +22,8 @@ from ..io.outputs import replacing
 from ..drives.waveforms import Waveform, parse_waveform
 
 __all__ = ["RolloutResult", "Decided", "Samples", "MAX_STEPS", "DEFAULT_SAMPLES", "check_work", "check_sampling",
-           "voltage_steps", "to_waveform", "one_voltage", "check_initial_curvature", "sample_steps", "lockstep"]
+           "voltage_steps", "to_waveform", "one_voltage", "check_initial_curvature", "sample_steps", "lockstep",
+           "CONTROLLER_CONTRACT", "check_controller", "controller_every", "reset_controller"]
 
 #: at most this many samples are kept per rollout unless sample_interval is given
 DEFAULT_SAMPLES = 5000
@@ -185,10 +186,15 @@ def check_work(duration: float, dt: float, max_steps: Optional[int] = None) -> i
     return n
 
 
-def check_sampling(wave, dt: float) -> None:
+#: what to change when a waveform is above the step's Nyquist frequency, by who owns the step
+SCENE_TIMESTEP = "pass a smaller timestep to the Scene (Scene(..., timestep=...), --timestep)"
+
+
+def check_sampling(wave, dt: float, remedy: str = SCENE_TIMESTEP) -> None:
     """Refuse a waveform whose content the step cannot represent: a frequency at or above
     the Nyquist frequency 1/(2 dt) (a sine of 13 kHz at dt = 77 us runs as an aliased
-    38 Hz one), or csv samples with more than ALIASED_ENERGY of their energy above it."""
+    38 Hz one), or csv samples with more than ALIASED_ENERGY of their energy above it.
+    ``remedy``: what to change, in words (the Scene's timestep, or a System's)."""
     if not isinstance(wave, Waveform):
         return
     f_n = 0.5 / dt
@@ -198,12 +204,13 @@ def check_sampling(wave, dt: float) -> None:
                 else f"frequency {wave.max_frequency:g} Hz is at or above")
         raise ParameterError("voltage", getattr(wave, "text", str(wave)),
                              f"content below the Nyquist frequency {f_n:.4g} Hz of the timestep {dt:.4g} s "
-                             f"({what} it and would alias)", "pass a smaller timestep to the Scene")
+                             f"({what} it and would alias)", remedy)
 
 
-def voltage_steps(wave, duration: float, dt: float, drive, max_steps: Optional[int] = None) -> np.ndarray:
+def voltage_steps(wave, duration: float, dt: float, drive, max_steps: Optional[int] = None,
+                  remedy: str = SCENE_TIMESTEP) -> np.ndarray:
     n_steps = check_work(duration, dt, max_steps)
-    check_sampling(wave, dt)
+    check_sampling(wave, dt, remedy)
     t_steps = np.arange(n_steps) * dt
     v = np.zeros(n_steps) if wave is None else np.asarray(wave(t_steps), dtype=float) * np.ones(n_steps)
     drive.check_voltage(v)
@@ -241,10 +248,69 @@ def one_voltage(value, name: str, where: str = "") -> float:
     ok = a is not None and a.size == 1 and a.dtype.kind in "iuf"
     v = float(a.reshape(-1)[0]) if ok else math.nan
     if not math.isfinite(v):
+        if not ok and a is not None and a.size == 1:      # the shape is right, the type is not (a bool, text)
+            shown = value if a.ndim == 0 else f"{type(value).__name__} of shape {a.shape} and dtype {a.dtype}"
+            raise ParameterError(name, shown, "one number, a finite voltage in V for one actuator: an int or float "
+                                 f"(a number or an array of shape (1,) of dtype float), not {a.dtype}", where)
         shown = value if ok or a is None or a.ndim == 0 else f"{type(value).__name__} of shape {a.shape}"
         raise ParameterError(name, shown, "one number, a finite voltage in V for one actuator (a number or an "
                              "array of shape (1,))", where)
     return v
+
+
+# ---------------------------------------------------------------- the controller contract
+#: one contract for :func:`mjeap.rollout` (a Scene) and :meth:`mjeap.System.rollout` (a System)
+CONTROLLER_CONTRACT = ("a callable controller(t, scene_or_system) -> voltage(s) in V: a function or an object with "
+                       "__call__; used when present: reset(scene_or_system, drive), interval (s), name, signals()")
+
+
+def check_controller(controller, voltage=None, voltage_name: str = "voltage") -> str:
+    """The controller contract, one for :func:`mjeap.rollout` and :meth:`mjeap.System.rollout`,
+    checked before any work; returns the controller's name.
+
+    A controller is any callable ``controller(t, target)`` (a plain function or an object with
+    ``__call__``), ``t`` in s and ``target`` the Scene or the System being run, that returns
+    the voltage to hold until its next call: one number (V) for a scene; for a system one per
+    actuator, one for all or a dict by prefix (None: unchanged). Used when present:
+    ``reset(target, drive)`` once before the first step (``drive``: the scene's drive; None for
+    a system, whose drives are ``system.actuators[i].drive``), ``interval`` (s, read after
+    ``reset``) the control period, rounded to whole steps (default: every step), ``name``
+    (default: the function's or class's name) in the result's meta and in errors, and
+    ``signals()`` (a dict of numbers) recorded at every sample as ``controller_<key>`` (a
+    scene's result). Its commands are checked and clipped to the drive's safe range
+    (:func:`one_voltage`). ``voltage`` (what the caller also gave) must be None with one."""
+    if not callable(controller):
+        raise ParameterError("controller", controller, CONTROLLER_CONTRACT, "it is not callable")
+    for attr in ("reset", "signals"):
+        if getattr(controller, attr, None) is not None and not callable(getattr(controller, attr)):
+            raise ParameterError(f"controller.{attr}", getattr(controller, attr), f"a method, or none: {CONTROLLER_CONTRACT}")
+    if voltage is not None:
+        raise ParameterError(voltage_name, getattr(voltage, "text", voltage), "None when a controller sets the voltage")
+    name = getattr(controller, "name", None)
+    return str(name) if name else getattr(controller, "__name__", None) or type(controller).__name__
+
+
+def reset_controller(controller, target, drive) -> None:
+    """``controller.reset(target, drive)`` where the controller has one (:func:`check_controller`)."""
+    reset = getattr(controller, "reset", None)
+    if reset is not None:
+        reset(target, drive)
+
+
+def controller_every(controller, dt: float) -> int:
+    """The controller's period in whole steps of ``dt`` s: its ``interval`` (s, checked: finite
+    and > 0) rounded, at least one step; every step without one."""
+    interval = getattr(controller, "interval", None)
+    if interval is None:
+        return 1
+    try:
+        h = float(interval)
+    except (TypeError, ValueError):
+        h = math.nan
+    if isinstance(interval, bool) or not (0 < h < math.inf):
+        raise ParameterError("controller.interval", interval, "a finite number > 0 s (the control period), or none "
+                             "for every step")
+    return max(1, int(round(h / dt)))
 
 
 #: the largest initial bend accepted: a uniform arc closing into a full circle

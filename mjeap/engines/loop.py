@@ -9,13 +9,15 @@ from __future__ import annotations
 
 import math
 import sys
+import warnings
+from typing import Optional
 
 import mujoco
 import numpy as np
 
 from ..errors import DivergenceError
 from .base import Engine
-from .frame import Decided, lockstep, one_voltage
+from .frame import Decided, controller_every, lockstep, one_voltage, reset_controller
 
 try:  # progress bars are optional
     from tqdm import tqdm
@@ -34,13 +36,59 @@ def advance(model, data, drive, voltage: float, dt: float, nstep: int = 1) -> No
         mujoco.mj_step(model, data)
 
 
-def divergence_error(scene, drv, voltage: float, step: int, who: str = "") -> DivergenceError:
+#: what a divergence check keeps of the state at its window's start (state and applied forces)
+WINDOW_STATE = mujoco.mjtState.mjSTATE_INTEGRATION
+
+
+def window_state(scene, out: Optional[np.ndarray] = None) -> np.ndarray:
+    """The scene's state and applied forces now (:data:`WINDOW_STATE`): the start of the
+    window a later :func:`divergence_error` replays."""
+    m, d = scene.model, scene.data
+    if out is None:
+        out = np.empty(mujoco.mj_stateSize(m, WINDOW_STATE))
+    mujoco.mj_getState(m, d, out, WINDOW_STATE)
+    return out
+
+
+def beam_diverges_alone(scene, start: np.ndarray, nstep: int) -> bool:
+    """Whether the beam, replayed for ``nstep`` steps from ``start`` (:func:`window_state`, a
+    finite state) with the forces applied then held and no drive, diverges: then a drive's
+    moment found non-finite at the end of the window followed the beam's state (it reads it)
+    and is not the cause. The scene's data is put back as it was."""
+    m, d = scene.model, scene.data
+    now, counts = window_state(scene), [w.number for w in d.warning]
+    try:
+        mujoco.mj_setState(m, d, start, WINDOW_STATE)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore")         # MuJoCo's bad-state warnings of the replay
+            for _ in range(max(1, int(nstep))):
+                mujoco.mj_step(m, d)
+                if diverged_state(d):
+                    return True
+        return False
+    finally:
+        mujoco.mj_setState(m, d, now, WINDOW_STATE)
+        for w, n in zip(d.warning, counts):
+            w.number = n
+
+
+def diverged_state(d) -> bool:
+    """The state (qpos, qvel) is no longer finite."""
+    return not math.isfinite(float(d.qpos.sum()) + float(d.qvel.sum()))
+
+
+def divergence_error(scene, drv, voltage: float, step: int, who: str = "", window=None) -> DivergenceError:
     """The error of a lockstep run of ``scene`` and ``drv`` that blew up by ``step`` (the
     last with ``voltage`` V held): a drive whose own moment is not finite is named as the
-    cause, else the scene's error (timestep against its stability limit) with the drive and
-    voltage, and ``who`` (a controller) added."""
+    cause, else the scene's error (timestep against its stability limit, a payload of the
+    wrong unit) with the drive and voltage, and ``who`` (a controller) added. ``window``
+    (start state, steps; :func:`window_state`): where the beam's state is not finite either,
+    the steps since the last check are replayed without the drive
+    (:func:`beam_diverges_alone`) and a beam that diverges on its own is not blamed on the drive."""
     d = scene.data
     bad = d.qfrc_applied[~np.isfinite(d.qfrc_applied)]
+    if bad.size and window is not None and diverged_state(d) and beam_diverges_alone(scene, *window):
+        bad = bad[:0]            # the drive read a beam already gone: the beam's error
     if bad.size:                 # the drive's own output, not the timestep
         return DivergenceError(
             f"the drive {drv.describe()} applied a non-finite moment ({bad[0]}) by t = "
@@ -81,9 +129,9 @@ def run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, prog
     ctrl_every, (v_lo, v_hi) = n_steps + 1, drv.voltage_range()
     state = {"saturated": 0, "hold": 0.0}
     ctrl_name = None
-    if controller is not None:
-        controller.reset(scene, drv)
-        ctrl_every = max(1, int(round(getattr(controller, "interval", dt) / dt)))
+    if controller is not None:          # the contract: mjeap.engines.frame.check_controller
+        reset_controller(controller, scene, drv)
+        ctrl_every = controller_every(controller, dt)
         ctrl_name = meta["controller"]
     show = (n_steps > PROGRESS_STEPS and sys.stderr.isatty()) if progress is None else progress
     bar = tqdm(total=n_steps, unit="step", desc=f"{scene.actuator.id} {drv.name}", disable=not show,
@@ -116,13 +164,17 @@ def run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, prog
             stop.step = scene._step_count = step
             raise
 
+    window = [window_state(scene), 0]        # the last state checked: a divergence replays from it
+
     def check(done, k):
         try:
             scene._step_count = done
             scene.check_finite()
         except DivergenceError:
             who = f" Controller: {ctrl_name} (check its gains)." if controller is not None else ""
-            raise divergence_error(scene, drv, v_steps[k], done, who) from None
+            raise divergence_error(scene, drv, v_steps[k], done, who, (window[0], done - window[1])) from None
+        window_state(scene, window[0])
+        window[1] = done
 
     try:
         lockstep(m, d, n_steps, sample_steps, open_loop if controller is None else closed_loop, sample, check, check_every,

@@ -12,10 +12,11 @@ it, and the readers here apply it.
 from __future__ import annotations
 
 import csv
+import io
 import numbers
 import re
 from pathlib import Path
-from typing import List
+from typing import List, Tuple
 
 import numpy as np
 
@@ -64,6 +65,12 @@ class writer:
 
 def read_rows(path, what: str = "data file") -> List[List[str]]:
     """All rows of a text CSV (header first), stripped of a BOM, the delimiter sniffed."""
+    return read_table(path, what)[0]
+
+
+def read_table(path, what: str = "data file") -> Tuple[List[List[str]], str]:
+    """:func:`read_rows` and the delimiter it found (',', ';' or a tab): a file mjeap
+    appends to (a sweep's CSV re-saved by a spreadsheet) goes on in its own form."""
     p = Path(path)
     if not p.is_file():
         raise ParameterError(what, str(path), "an existing CSV file")
@@ -76,13 +83,32 @@ def read_rows(path, what: str = "data file") -> List[List[str]]:
         text = raw.decode("latin-1")          # every byte is a character: Windows-saved files
     if not text.strip():
         raise ParameterError(what, str(path), "a CSV with a header row and data")
-    sample = "\n".join(text.splitlines()[:20])
+    delimiter = _delimiter("\n".join(text.splitlines()[:20]))
+    return [[plain_cell(c) for c in row] for row in csv.reader(io.StringIO(text, newline=""), delimiter=delimiter)
+            if row], delimiter
+
+
+def _delimiter(sample: str) -> str:
+    """The delimiter of a CSV's first lines: of ',', ';' and tab, the one that splits the
+    header into two or more columns and the most rows into as many (csv's Sniffer alone took
+    ',' for a ';' file whose cells hold commas, a sweep's settings); the Sniffer's choice
+    among equals, ',' for a single column."""
     try:
-        dialect = csv.Sniffer().sniff(sample, delimiters=",;\t")
-        delimiter = dialect.delimiter
+        sniffed = csv.Sniffer().sniff(sample, delimiters=",;\t").delimiter
     except csv.Error:
-        delimiter = ","
-    return [[plain_cell(c) for c in row] for row in csv.reader(text.splitlines(), delimiter=delimiter) if row]
+        sniffed = ","
+    scores = {}
+    for d in ",;\t":
+        try:
+            rows = [r for r in csv.reader(io.StringIO(sample, newline=""), delimiter=d) if r]
+        except csv.Error:
+            continue
+        if rows and len(rows[0]) >= 2:
+            scores[d] = (sum(len(r) == len(rows[0]) for r in rows), len(rows[0]))
+    if not scores:
+        return sniffed
+    best = max(scores.values())
+    return sniffed if scores.get(sniffed) == best else max(scores, key=scores.get)
 
 
 def number(cell: str, what: str, line: int) -> float:

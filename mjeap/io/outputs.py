@@ -1,11 +1,22 @@
-"""Files that survive a stop, a kill or a second writer.
+"""Files that survive a stop, a kill, a full disk or a second writer, and never replace what
+is not a regular file of ours.
 
-* :func:`replacing`: every file mjeap writes is written to a temporary file beside it and
-  renamed onto its path when complete (fsynced first), so a reader sees the old file or the
-  whole new one, never a part; SIGINT and SIGTERM wait for the rename.
+* :func:`output_kind`: what a path is. A regular file (or none yet) is written whole; a
+  character device or a FIFO (``/dev/null``, ``/dev/stdout`` on a pipe, a named pipe) is a
+  stream, written through, never replaced; anything else (a directory, a block device, a
+  socket) is refused, naming the parameter.
+* :func:`replacing`: a regular file is written to a temporary file beside it (an
+  unguessable name, created exclusively) and renamed onto its path when complete and
+  fsynced, so a reader sees the old file or the whole new one, never a part. A write that
+  fails (a full disk: ENOSPC) leaves the old file in place and raises; SIGINT and SIGTERM
+  wait for the rename. A stream gets the finished bytes, copied through.
 * :func:`hold`: a lock (``PATH.lock``, ``fcntl.flock``) refuses a second writer of the same
-  path, from this or another process, at once. The OS drops the lock of a process that
-  dies, so a lock file left by a killed one blocks nothing; a released lock file is removed.
+  path, from this or another process, at once. The lock file is opened without following
+  links; one that is a link, not a regular file, has other hard links or holds what mjeap
+  did not write is refused, naming it. The OS drops the lock of a process that dies, so a
+  lock file left by a killed one blocks nothing; the temporary it names (ours) is removed
+  then, and nothing else. A released lock file is removed. A stream is held open instead
+  (a FIFO's reader then sees one writer from the check to the end).
 * :func:`check_outputs` checks a run's output paths before any work; :func:`write_outputs`
   writes each on its own at the end, one failure not stopping the others.
 * :func:`guarded`: a run (a stepping loop) checks and locks its outputs before any work and,
@@ -13,12 +24,16 @@
 """
 from __future__ import annotations
 
+import errno
 import functools
-import glob
 import inspect
 import os
+import re
 import secrets
+import shutil
 import signal
+import stat
+import tempfile
 import threading
 from contextlib import ExitStack, contextmanager
 from pathlib import Path
@@ -26,44 +41,154 @@ from typing import Dict, Optional
 
 from ..errors import OutputError, ParameterError, sigterm_as_interrupt
 
-_held: dict = {}                       # real path -> [(pid, thread), count, fd]
+_held: dict = {}                       # key -> [(pid, thread), count, fd, kind, lock path, holder]
 _held_lock = threading.Lock()
+#: what a lock file of mjeap's starts with
+LOCK_TAG = "mjeap "
+_STREAMS = "a regular file, or a character device or FIFO to stream to"
 
 
-def _lock_file(path: Path, name: str, holder: str, given) -> int:
-    """An exclusive flock on ``path``.lock (its fd), or ParameterError naming the ``given`` path."""
+def _stat_kind(mode: int) -> str:
+    for test, word in ((stat.S_ISDIR, "directory"), (stat.S_ISBLK, "block device"), (stat.S_ISSOCK, "socket"),
+                       (stat.S_ISCHR, "character device"), (stat.S_ISFIFO, "FIFO")):
+        if test(mode):
+            return word
+    return "special file"
+
+
+def output_kind(path, name: str = "path") -> str:
+    """``"file"`` (a regular file, through any links), ``"new"`` (nothing there yet) or
+    ``"stream"`` (a character device or FIFO: written through, never replaced); anything
+    else is refused with a :class:`ParameterError` on ``name``. The path is followed as the
+    kernel does (``/dev/stdout`` is whatever fd 1 is)."""
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        return "new"
+    except OSError as e:
+        raise ParameterError(name, str(path), "a path mjeap can write",
+                             f"cannot write {path}: {e.strerror or e}") from None
+    if stat.S_ISREG(st.st_mode):
+        return "file"
+    if stat.S_ISCHR(st.st_mode) or stat.S_ISFIFO(st.st_mode):
+        return "stream"
+    kind = _stat_kind(st.st_mode)
+    raise ParameterError(name, str(path), "a file path" if kind == "directory" else _STREAMS,
+                         f"it is a {kind}: refused, never replaced")
+
+
+def _key(path, kind: str):
+    if kind == "stream":
+        st = os.stat(path)
+        return ("stream", st.st_dev, st.st_ino)
+    return Path(os.path.realpath(path))
+
+
+# ---------------------------------------------------------------- locks and held streams
+def _refuse(name, given, lock, why):
+    return ParameterError(name, str(given), "a path whose lock file mjeap can create and own",
+                          f"{lock} {why}: refused, not overwritten; remove it if it is yours")
+
+
+def _temporary_pattern(target: Path) -> re.Pattern:
+    return re.compile(re.escape(f".{target.name}.") + r"[0-9a-f]{16}" + re.escape(f".tmp{target.suffix}"))
+
+
+def _lock_file(target: Path, name: str, holder: str, given) -> int:
+    """An exclusive flock on ``target``.lock (its fd), or ParameterError naming the ``given``
+    path: the lock file is opened without following links and must be a regular file of
+    ours (one name, mjeap's text or empty)."""
     try:
         import fcntl
     except ImportError:  # pragma: no cover - not POSIX: no lock, as the sweep before
         return -1
-    lock = path.with_name(path.name + ".lock")
+    lock = target.with_name(target.name + ".lock")
     while True:
-        fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o666)
+        try:
+            st = os.lstat(lock)
+            if not stat.S_ISREG(st.st_mode):      # never open a device, FIFO or link named like it
+                raise _refuse(name, given, lock, "is a symbolic link" if stat.S_ISLNK(st.st_mode)
+                              else f"is a {_stat_kind(st.st_mode)}, not mjeap's lock file")
+        except FileNotFoundError:
+            pass
+        try:
+            fd = os.open(lock, os.O_RDWR | os.O_CREAT | os.O_NOFOLLOW | os.O_NONBLOCK | os.O_CLOEXEC, 0o644)
+        except OSError as e:
+            if e.errno == errno.ELOOP:
+                raise _refuse(name, given, lock, "is a symbolic link") from None
+            raise ParameterError(name, str(given), "a path in a folder where mjeap can create its lock file",
+                                 f"cannot create {lock}: {e.strerror or e}") from None
+        st = os.fstat(fd)
+        if not stat.S_ISREG(st.st_mode) or st.st_nlink != 1:
+            os.close(fd)
+            raise _refuse(name, given, lock, "has another hard link" if stat.S_ISREG(st.st_mode)
+                          else "is not a regular file")
         try:
             fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except OSError:
-            other = os.read(fd, 200).decode(errors="replace").strip()
+            other = os.pread(fd, 200, 0).decode(errors="replace").strip()
             os.close(fd)
             raise ParameterError(name, str(given), f"a file no other {holder} is writing",
                                  f"another {other or holder} holds its lock ({lock}): refused, not waiting; "
                                  "let it finish or choose another path") from None
         try:
-            same = os.path.samestat(os.stat(lock), os.fstat(fd))
+            same = os.path.samestat(os.lstat(lock), st)
         except FileNotFoundError:
             same = False
-        if same:           # else its last holder removed it meanwhile: lock the file now there
-            os.ftruncate(fd, 0)
-            os.write(fd, f"{holder} (pid {os.getpid()})".encode())
-            return fd
-        os.close(fd)
+        if not same:       # its last holder removed it meanwhile: lock the file now there
+            os.close(fd)
+            continue
+        text = os.pread(fd, 4096, 0).decode(errors="replace")
+        if text and not text.startswith(LOCK_TAG):
+            os.close(fd)
+            raise _refuse(name, given, lock, f"exists and is not an mjeap lock file (it holds {text[:40]!r})")
+        # a writer killed mid-write left its temporary: ours (named in our lock), so removed
+        m = re.search(r" tmp=(\S+)", text)
+        if m and _temporary_pattern(target).fullmatch(m.group(1)):
+            stale = target.with_name(m.group(1))
+            try:
+                if stat.S_ISREG(os.lstat(stale).st_mode):
+                    os.unlink(stale)
+            except OSError:
+                pass
+        _write_lock(fd, holder)
+        return fd
+
+
+def _write_lock(fd: int, holder: str, temporary: Optional[str] = None) -> None:
+    if fd < 0:
+        return
+    text = f"{LOCK_TAG}{holder.removeprefix(LOCK_TAG)} (pid {os.getpid()})" + (f" tmp={temporary}" if temporary else "")
+    os.ftruncate(fd, 0)
+    os.pwrite(fd, text.encode(), 0)
+
+
+def _open_stream(path, name: str) -> int:
+    """An fd writing to the stream ``path``; a FIFO must have a reader now (else refused:
+    waiting for one could hang forever)."""
+    fifo = stat.S_ISFIFO(os.stat(path).st_mode)
+    try:
+        fd = os.open(path, os.O_WRONLY | os.O_NOCTTY | os.O_CLOEXEC | (os.O_NONBLOCK if fifo else 0))
+    except OSError as e:
+        if e.errno == errno.ENXIO:
+            raise ParameterError(name, str(path), "a FIFO that a process is reading",
+                                 "nobody reads it: start its reader first") from None
+        raise ParameterError(name, str(path), "a stream mjeap can write",
+                             f"cannot open {path}: {e.strerror or e}") from None
+    if fifo:
+        import fcntl
+        fcntl.fcntl(fd, fcntl.F_SETFL, fcntl.fcntl(fd, fcntl.F_GETFL) & ~os.O_NONBLOCK)
+    return fd
 
 
 @contextmanager
 def hold(path, name: str = "path", holder: str = "mjeap run"):
-    """Hold the lock of output ``path`` for the block: another process or thread holding it
-    is refused at once (ParameterError on ``name``, naming the path and the holder); the
-    same thread may hold it again (a run's writers within the run)."""
-    key = Path(os.path.realpath(path))
+    """Hold the lock of output ``path`` for the block (a stream: hold it open): another
+    process or thread holding it is refused at once (ParameterError on ``name``, naming the
+    path and the holder); the same thread may hold it again (a run's writers within the
+    run). Yields the key the path is held under."""
+    kind = output_kind(path, name)
+    key = _key(path, kind)
     me = (os.getpid(), threading.get_ident())
     with _held_lock:
         entry = _held.get(key)
@@ -73,7 +198,9 @@ def hold(path, name: str = "path", holder: str = "mjeap run"):
         if entry is not None and entry[0] == me:
             entry[1] += 1
         else:                                          # none here (or one inherited through fork)
-            entry = _held[key] = [me, 1, _lock_file(key, name, holder, path)]
+            fd = _open_stream(path, name) if kind == "stream" else _lock_file(key, name, holder, path)
+            lock = None if kind == "stream" else key.with_name(key.name + ".lock")
+            entry = _held[key] = [me, 1, fd, kind, lock, holder]
     try:
         yield key
     finally:
@@ -81,12 +208,15 @@ def hold(path, name: str = "path", holder: str = "mjeap run"):
             entry[1] -= 1
             if entry[1] == 0:
                 del _held[key]
-                if entry[2] >= 0:
-                    try:
-                        os.unlink(key.with_name(key.name + ".lock"))   # still locked: no one else has it
-                    except OSError:
-                        pass
-                    os.close(entry[2])
+                fd, lock = entry[2], entry[4]
+                if fd >= 0:
+                    if lock is not None:
+                        try:                           # still ours (locked): no one else has it
+                            if os.path.samestat(os.lstat(lock), os.fstat(fd)):
+                                os.unlink(lock)
+                        except OSError:
+                            pass
+                    os.close(fd)
 
 
 class deferred_signals:
@@ -134,41 +264,88 @@ def _fsync(path) -> None:
     fd = os.open(path, os.O_RDONLY)
     try:
         os.fsync(fd)
-    except OSError:  # pragma: no cover - a directory on a file system that refuses it
-        pass
+    except OSError as e:  # a directory on a file system that refuses it is fine; a file is not
+        if not os.path.isdir(path):
+            raise
+        del e
     finally:
         os.close(fd)
 
 
+def _umask() -> int:
+    m = os.umask(0)
+    os.umask(m)
+    return m
+
+
+def _write_all(fd: int, src) -> None:
+    with open(src, "rb") as fh:
+        while True:
+            chunk = fh.read(1 << 20)
+            if not chunk:
+                return
+            view = memoryview(chunk)
+            while view:
+                view = view[os.write(fd, view):]
+
+
 @contextmanager
 def replacing(path, name: str = "path"):
-    """A temporary path beside ``path`` (same suffix) for the block to write, renamed onto
-    ``path`` when the block ends, fsynced first. A block that raises still puts what it
-    wrote in place (a partial output is kept; the error says so); one that wrote nothing
-    leaves ``path`` as it was. The path's lock is held meanwhile (:func:`hold`), SIGINT
-    and SIGTERM are delivered after the rename, and temporaries of a writer killed mid-write
-    are removed."""
+    """A temporary path for the block to write, put in place when the block ends.
+
+    A regular file (or none yet): the temporary lies beside ``path`` (an unguessable name,
+    created exclusively, named in the path's lock so that only it is ever cleaned up), is
+    fsynced and renamed onto ``path``; an existing file keeps its mode. A block that raises,
+    or a write that fails (a full disk), leaves ``path`` as it was and removes the
+    temporary: a reader sees the old file or the whole new one. A stream (a character
+    device or FIFO) gets the finished bytes written through, and is never replaced. The
+    path's lock is held meanwhile (:func:`hold`); SIGINT and SIGTERM are delivered after."""
+    kind = output_kind(path, name)
+    if kind == "stream":
+        with hold(path, name) as key, deferred_signals():
+            folder = Path(tempfile.mkdtemp(prefix="mjeap-"))
+            try:
+                tmp = folder / f"out{Path(path).suffix}"
+                yield tmp
+                if tmp.exists():
+                    _write_all(_held[key][2], tmp)
+            finally:
+                shutil.rmtree(folder, ignore_errors=True)
+        return
     target = Path(os.path.realpath(path))
     target.parent.mkdir(parents=True, exist_ok=True)
-    with hold(target, name), deferred_signals():
-        for stale in target.parent.glob(glob.escape(f".{target.name}.") + "*" + glob.escape(f".tmp{target.suffix}")):
-            stale.unlink()                          # left by a writer killed mid-write (we hold the lock)
-        tmp = target.with_name(f".{target.name}.{secrets.token_hex(4)}.tmp{target.suffix}")
-        ok = False
+    with hold(target, name) as key, deferred_signals():
+        entry = _held[key]
+        while True:
+            tmp = target.with_name(f".{target.name}.{secrets.token_hex(8)}.tmp{target.suffix}")
+            try:
+                os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL | os.O_NOFOLLOW | os.O_CLOEXEC, 0o666))
+                break
+            except FileExistsError:
+                continue
+            except OSError as e:
+                raise OutputError([(str(path), f"cannot create a temporary file beside it: {e.strerror or e}")]) \
+                    from None
+        _write_lock(entry[2], entry[5], tmp.name)
         try:
             yield tmp
-            ok = True
+            if not tmp.exists():                      # the block wrote nothing: the path stays
+                return
+            try:
+                mode = os.stat(target).st_mode & 0o7777
+            except FileNotFoundError:
+                mode = 0o666 & ~_umask()
+            os.chmod(tmp, mode)
+            _fsync(tmp)
+            os.replace(tmp, target)
+            _fsync(target.parent)
         finally:
-            if tmp.exists() and (ok or tmp.stat().st_size > 0):
-                try:
-                    os.chmod(tmp, os.stat(target).st_mode & 0o7777)    # an existing file keeps its mode
-                except OSError:
-                    pass
-                _fsync(tmp)
-                os.replace(tmp, target)
-                _fsync(target.parent)
-            elif tmp.exists():
-                tmp.unlink()
+            try:
+                if stat.S_ISREG(os.lstat(tmp).st_mode):
+                    os.unlink(tmp)
+            except OSError:
+                pass
+            _write_lock(entry[2], entry[5])
 
 
 @contextmanager
@@ -209,26 +386,31 @@ def provenance() -> dict:
 
 
 def check_outputs(**paths) -> Dict[str, Path]:
-    """The outputs a run will write (name -> path or None), checked before any work: distinct
-    files, not directories, in a folder that exists or can be made and is writable."""
+    """The outputs a run will write (name -> path or None), checked before any work:
+    distinct, each a regular file (or none yet) in a folder that exists or can be made and
+    is writable, or a writable stream (:func:`output_kind`)."""
     out, seen = {}, {}
     for name, p in paths.items():
         if p is None:
             continue
         p = Path(p)
-        key = p.resolve()
+        kind = output_kind(p, name)
+        key = _key(p, kind)
         if key in seen:
             raise ParameterError(name, str(p), f"a file other than the {seen[key]} output's")
         seen[key] = name
-        if p.is_dir():
-            raise ParameterError(name, str(p), "a file path (it is a directory)")
-        parent = p.parent
+        if kind == "stream":
+            if not os.access(p, os.W_OK):
+                raise ParameterError(name, str(p), "a writable path", f"cannot write {p}: permission denied")
+            out[name] = p
+            continue
+        parent = key.parent
         try:
             parent.mkdir(parents=True, exist_ok=True)
         except OSError as e:
             raise ParameterError(name, str(p), "a path in a folder that exists or can be made",
                                  f"cannot write {p}: {e.strerror or e}") from None
-        if not os.access(parent, os.W_OK) or (p.exists() and not os.access(p, os.W_OK)):
+        if not os.access(parent, os.W_OK | os.X_OK) or (kind == "file" and not os.access(key, os.W_OK)):
             raise ParameterError(name, str(p), "a writable path", f"cannot write {p}: permission denied")
         out[name] = p
     return out
@@ -245,7 +427,8 @@ def write_outputs(writers, error: Optional[BaseException], result=None) -> None:
             try:
                 write()
             except Exception as e:                   # noqa: BLE001 - reported, never masks the run's error
-                failures.append((path, f"{type(e).__name__}: {e}"))
+                why = e.strerror if isinstance(e, OSError) and e.strerror and not isinstance(e, OutputError) else e
+                failures.append((path, f"{type(e).__name__}: {why}"))
     if not failures:
         return
     if error is not None:

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import re
 from collections import OrderedDict
+from contextlib import contextmanager
 from pathlib import Path
 
 import mujoco
@@ -189,6 +190,27 @@ def _log_outcome(rec, meta: dict, t, extra) -> None:
         extra(rec)
 
 
+@contextmanager
+def rrd_file(rec, path, blueprint=None):
+    """Log to the recording stream ``rec`` within the block; when it ends, its bytes (with
+    ``blueprint`` as the default layout) are written to ``path`` by Python's own file I/O,
+    so that a full disk or a closed stream raises. Rerun's file sink (``rec.save``) only
+    logs such an error and leaves a torn file that fails ``rerun rrd verify``. Nothing is
+    written when the block raises."""
+    stream = rec.binary_stream()
+    if blueprint is not None:
+        rec.send_blueprint(blueprint, make_active=False, make_default=True)
+    try:
+        yield rec
+        rec.flush()
+        data = stream.read(flush=True) or b""
+    finally:
+        rec.disconnect()
+    with open(path, "wb") as fh:
+        fh.write(data)
+        fh.flush()
+
+
 def write_recording(path, result, scene, extra=None, views=(), deformation: float = None) -> Path:
     """Write ``result`` of a rollout of ``scene`` to ``path`` (.rrd); the file is flushed,
     closed and renamed into place whole (:func:`mjeap.outputs.replacing`) before returning,
@@ -217,8 +239,7 @@ def _write_recording(path, result, scene, extra, views, deformation) -> None:
         shown = result.centreline[idx].copy()
         shown[..., 1:] *= scale                                      # magnified deflection
         shown = shown @ scene.rotation.T                             # (f, N + 2, 3), world axes
-    rec.save(str(path), default_blueprint=blueprint(result, scale, bar, views))
-    try:
+    with rrd_file(rec, path, blueprint(result, scale, bar, views)):
         t = result.time
         R = scene.rotation  # clamp frame -> world
         rec.log("meta", rr.TextDocument(_meta_markdown({**result.meta, "deformation_shown": f"x{scale:g}"}),
@@ -267,9 +288,6 @@ def _write_recording(path, result, scene, extra, views, deformation) -> None:
                 rec.send_columns("beam/payload", indexes=[tf], columns=rr.Points3D.columns(positions=pp @ R.T))
                 rec.log("beam/payload", rr.Points3D.from_fields(radii=[pay_r], colors=[[190, 50, 50]]), static=True)
         _log_outcome(rec, result.meta, t, extra)
-    finally:
-        rec.flush()
-        rec.disconnect()
 
 
 def read_recording(path) -> dict:
@@ -362,8 +380,7 @@ def _write_system_recording(path, result, system, extra, views, actuator_views=T
                        rrb.BlueprintPanel(state="collapsed"), rrb.SelectionPanel(state="collapsed"),
                        rrb.TimePanel(state="collapsed", timeline="time", play_state="paused"))
     rec = rr.RecordingStream("mjeap", recording_id=f"system-{'-'.join(names)}")
-    rec.save(str(path), default_blueprint=bp)
-    try:
+    with rrd_file(rec, path, bp):
         rec.log("meta", rr.TextDocument(_meta_markdown(result.meta), media_type="text/markdown"), static=True)
         t = result.time
         n = len(t)
@@ -421,9 +438,6 @@ def _write_system_recording(path, result, system, extra, views, actuator_views=T
             rec.send_columns(ent, indexes=[rr.TimeColumn("time", duration=t)],
                              columns=rr.Scalars.columns(scalars=np.linalg.norm(result.contact_force[:, b], axis=1)))
         _log_outcome(rec, result.meta, t, extra)
-    finally:
-        rec.flush()
-        rec.disconnect()
 
 
 def _quat_mat(q) -> np.ndarray:

@@ -16,7 +16,7 @@ from typing import Optional, Tuple
 
 import numpy as np
 
-from .catalog import Actuator
+from .actuator import Actuator
 from ..errors import ParameterError, check_positive, check_range
 
 #: density used for a payload whose size is not given: sintered NdFeB, as the magnets

@@ -4,6 +4,9 @@
 ball joint); :func:`load_mjcf` loads a file with them applied."""
 from __future__ import annotations
 
+import os
+import stat
+from pathlib import Path
 from typing import Optional
 
 import mujoco
@@ -79,6 +82,50 @@ def apply_dof_damping(model: mujoco.MjModel) -> mujoco.MjModel:
     return model
 
 
+def _regular(target: Path, path, why: str) -> None:
+    """Refuse ``target`` where it exists and is not a regular file (a FIFO, a device, a
+    folder): MuJoCo's reader would wait on it without end."""
+    try:
+        mode = os.stat(target).st_mode
+    except OSError:
+        return                           # missing: MuJoCo says so
+    if not stat.S_ISREG(mode):
+        kind = "a FIFO" if stat.S_ISFIFO(mode) else "a folder" if stat.S_ISDIR(mode) else "not a regular file"
+        raise ParameterError("path", str(path), "an MJCF file whose includes are regular files", f"{why} {target} "
+                             f"is {kind}")
+
+
+def check_includes(path) -> None:
+    """The MJCF file ``path`` and every file it ``<include>`` s (and they include, relative to
+    the main file's folder or the including file's) are regular files, checked before MuJoCo
+    reads them: a FIFO among them would hang MuJoCo's reader."""
+    import xml.etree.ElementTree as ET
+    main = Path(path)
+    if not main.is_file():
+        raise ParameterError("path", str(path), "an existing MJCF file (a regular file)")
+    todo, seen = [main], set()
+    while todo:
+        f = todo.pop()
+        if f in seen:
+            continue
+        seen.add(f)
+        try:
+            root = ET.parse(f).getroot()
+        except (ET.ParseError, OSError):
+            continue                     # MuJoCo's own error names the problem
+        for inc in root.iter("include"):
+            name = inc.get("file")
+            if not name:
+                continue
+            for target in dict.fromkeys((main.parent / name, f.parent / name)):
+                _regular(target, path, f"<include file={name!r}> in {f.name}:")
+                if target.is_file():
+                    todo.append(target)
+
+
 def load_mjcf(path: str) -> mujoco.MjModel:
-    """Load a model written by mjeap (``assets/mjcf``) with its per-dof damping applied."""
+    """Load a model written by mjeap (``assets/mjcf``) with its per-dof damping applied; a
+    file, or a file it includes, that is not a regular file (a FIFO would hang MuJoCo's
+    reader) is refused first (:func:`check_includes`)."""
+    check_includes(path)
     return apply_dof_damping(mujoco.MjModel.from_xml_path(str(path)))

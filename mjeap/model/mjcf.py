@@ -34,7 +34,7 @@ import mujoco
 import numpy as np
 
 from .discretize import BeamLayout, Payload, block_inertia, clamp_rotation
-from ..errors import ParameterError, UnknownNameError
+from ..errors import ParameterError, UnknownNameError, check_registration
 from ..units import UnitSystem
 
 GRAVITY = 9.80665  # m/s^2
@@ -295,11 +295,33 @@ class CableBuilder(BeamBuilder):
 BUILDERS: Dict[str, BeamBuilder] = {"hinge": HingeChainBuilder(), "cable": CableBuilder()}
 
 
-def register(builder: BeamBuilder) -> BeamBuilder:
-    """Add a representation (its builder) to :data:`BUILDERS` (and its name to
-    :data:`REPRESENTATIONS`; ``mjeap.model`` imports every builder's module before anyone
-    reads it)."""
+def _builder_lacks(builder) -> Optional[str]:
+    """Why ``builder`` cannot be registered (None: it can)."""
+    if not isinstance(builder, BeamBuilder):
+        return ("a class, not an instance: register(MyBuilder())" if isinstance(builder, type)
+                and issubclass(builder, BeamBuilder) else "not a BeamBuilder")
+    missing = [m for m in ("build", "view") if getattr(type(builder), m) is getattr(BeamBuilder, m)]
+    if missing:
+        return f"its {' and '.join(missing)} {'are' if len(missing) > 1 else 'is'} BeamBuilder's, which builds nothing"
+    d = builder.dofs_per_hinge
+    if isinstance(d, bool) or not isinstance(d, (int, np.integer)) or d < 1:
+        return f"its dofs_per_hinge is {d!r}, not an integer >= 1"
+    if builder.default_integrator not in builder.integrators:
+        return f"its default_integrator {builder.default_integrator!r} is not one of its integrators"
+    return None
+
+
+def register(builder: BeamBuilder, *, replace: bool = False) -> BeamBuilder:
+    """Add a representation (its builder: an instance of a :class:`BeamBuilder` subclass
+    that implements ``build`` and ``view``) to :data:`BUILDERS` under its ``representation``
+    (letters, digits, '-', '_'; and its name to :data:`REPRESENTATIONS`; ``mjeap.model``
+    imports every builder's module before anyone reads it). A name taken is refused unless
+    ``replace``."""
     global REPRESENTATIONS
+    check_registration("beam builder", BUILDERS, getattr(builder, "representation", None), builder,
+                       lacks=_builder_lacks(builder), expected="an instance of a mjeap.model.mjcf.BeamBuilder "
+                       "subclass that implements build and view, with a representation", replace=replace,
+                       how="mjeap.model.mjcf.register")
     BUILDERS[builder.representation] = builder
     REPRESENTATIONS = tuple(BUILDERS)
     return builder
@@ -339,6 +361,24 @@ def arena_bytes(nv: int) -> int:
     return (1 << 20) + 2 * 8 * (2 * nv) ** 2
 
 
+def _check_handles(builder: BeamBuilder, spec, layout: BeamLayout, handles) -> None:
+    """Refuse what a builder's ``build`` returned where it is not :class:`BeamHandles` of one
+    link body per segment, naming bodies the spec holds, naming the builder."""
+    fail = None
+    if not isinstance(handles, BeamHandles):
+        fail = f"its build returned {type(handles).__name__}, not BeamHandles"
+    elif not isinstance(handles.link_bodies, (list, tuple)) or len(handles.link_bodies) != layout.segments:
+        fail = f"its build named link bodies {handles.link_bodies!r} for {layout.segments} segments"
+    else:
+        names = [handles.clamp_body, *handles.link_bodies, handles.tip_body]
+        missing = [n for n in names if not isinstance(n, str) or spec.body(n) is None]
+        if missing:
+            fail = f"its build named bodies the model lacks: {', '.join(map(repr, missing[:3]))}"
+    if fail is not None:
+        raise ParameterError("representation", builder.representation, "a beam builder whose build returns "
+                             "BeamHandles naming one link body per segment and the tip body of the spec", fail)
+
+
 def build_spec(layout: BeamLayout, representation: str = "hinge", orientation: str = "horizontal",
                payload: Optional[Payload] = None, units: Optional[UnitSystem] = None,
                gravity: bool = True, model_name: Optional[str] = None):
@@ -374,6 +414,7 @@ def build_spec(layout: BeamLayout, representation: str = "hinge", orientation: s
     spec = mujoco.MjSpec.from_string(xml)
     spec.memory = arena_bytes(layout.segments * builder.dofs_per_hinge)
     handles = builder.build(spec, layout, units)
+    _check_handles(builder, spec, layout, handles)
     tip = spec.body(handles.tip_body)
     tip_local = (layout.tip_x - layout.link_start[-1]) / units.length
     tip.add_site(name="tip", pos=[tip_local, 0, 0], size=[0.01 * L, 0, 0], rgba=[1, 0.3, 0.1, 1])

@@ -16,7 +16,7 @@ from __future__ import annotations
 import importlib
 from typing import Dict, List, Optional
 
-from ..errors import UnknownNameError
+from ..errors import ParameterError, UnknownNameError
 from .registry import _REGISTRY, Robot, register, summary
 
 #: the modules that register the robots, imported on first use (they import SciPy and MjSpec code)
@@ -45,5 +45,11 @@ def get(name: str) -> Robot:
 
 
 def load(name: str, **options):
-    """Build robot ``name``'s System with its builder's ``options``."""
-    return get(name).build(**options)
+    """Build robot ``name``'s System with its builder's ``options`` (a builder that returns
+    anything else is refused, naming the robot)."""
+    from ..simulation.system import System
+    system = get(name).build(**options)
+    if not isinstance(system, System):
+        raise ParameterError("robot", name, "a robot whose build returns a mjeap.System",
+                             f"its build returned {type(system).__name__}")
+    return system

@@ -46,9 +46,12 @@ from __future__ import annotations
 
 import argparse
 import json
+import shutil
 import sys
+import tempfile
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 from typing import Optional
 
 import mujoco
@@ -57,6 +60,7 @@ from scipy import optimize
 
 from ..model.analytical import DadrasModel
 from ..cli import arg_number, arg_output, parse_args, run_script
+from ..io.outputs import replacing, run_guard
 from ..errors import ParameterError, check_range
 from ..sweep import stop_workers, worker_signals
 from .registry import Robot, register, summary
@@ -353,17 +357,24 @@ def main(argv=None):
     hold, lift_hold, rtol = (10.0, 2.0, 0.05) if a.quick else (a.hold, LIFT_HOLD, 0.02)
 
     v_cf = closed_form_min_lift_voltage()
-    # the long held run beside the bisection; stopped at once if the script is
+    # the long held run beside the bisection; stopped at once if the script is. The output
+    # is locked here before any work; the worker records into a private temporary file,
+    # put in place here once the held run is done (the lock is this process's)
     pool = ProcessPoolExecutor(max_workers=2, initializer=worker_signals)
-    try:
-        held = pool.submit(held_run, a.voltage, hold, a.out)
-        lift = min_lift_voltage(0.8 * v_cf, 1.25 * v_cf, rtol, lift_hold)
-        hard = hard_finger_check()
-        held = held.result()
-    except BaseException:
-        stop_workers(pool)
-        raise
-    pool.shutdown()
+    with run_guard(**{"--out": a.out}), tempfile.TemporaryDirectory(prefix="mjeap-gripper-") as folder:
+        held_rrd = None if not a.out else str(Path(folder) / "held.rrd")
+        try:
+            held = pool.submit(held_run, a.voltage, hold, held_rrd)
+            lift = min_lift_voltage(0.8 * v_cf, 1.25 * v_cf, rtol, lift_hold)
+            hard = hard_finger_check()
+            held = held.result()
+        except BaseException:
+            stop_workers(pool)
+            raise
+        pool.shutdown()
+        if held_rrd is not None:
+            with replacing(a.out, "--out") as tmp:
+                shutil.copyfile(held_rrd, tmp)
     v_sim = lift["voltage_v"]
     # the torsional friction the soft-finger grasp needs at the threshold, mu R sin(theta):
     # theta when the base starts to rise in the lowest try that lifted (the bracket's top)

@@ -49,6 +49,7 @@ from scipy import optimize
 
 from ..analysis.frequency import phasor
 from ..cli import arg_integer, arg_output, parse_args, run_script
+from ..io.outputs import run_guard
 from ..controllers.hamr_leg import (LIFT, SWING, LegPhaseController, cycles_to_within, free_estimator, leg_scene,
                                     phase_errors_per_cycle, phase_loop_gains)
 from ..errors import check_integer
@@ -334,15 +335,16 @@ def main(argv=None):
     d = design()
     system = build(d)
     out = {"leg_length_m": LEG_LENGTH, "assumed": "leg length", "design": d}
-    for name in DOFS:
-        sw = sweep(system, name)
-        out[f"{name}_sweep"] = sw
-        fit = second_order_fit(sw)
-        out[f"{name}_resonance_hz"] = fit["resonance_hz"]
-        out[f"{name}_fit"] = fit
-        out[f"{name}_phase_crossing_hz"] = phase_crossing(sw)
-        out[f"{name}_point_mass_resonance_hz"] = d[name]["point_mass_resonance_hz"]
-    run = run_closed_loop(system, a.cycles, a.open_loop_cycles, rrd=a.out)
+    with run_guard(**{"--out": a.out}):           # locked before any work
+        for name in DOFS:
+            sw = sweep(system, name)
+            out[f"{name}_sweep"] = sw
+            fit = second_order_fit(sw)
+            out[f"{name}_resonance_hz"] = fit["resonance_hz"]
+            out[f"{name}_fit"] = fit
+            out[f"{name}_phase_crossing_hz"] = phase_crossing(sw)
+            out[f"{name}_point_mass_resonance_hz"] = d[name]["point_mass_resonance_hz"]
+        run = run_closed_loop(system, a.cycles, a.open_loop_cycles, rrd=a.out)
     for name in DOFS:
         e = run["errors"][name]
         out[f"cycles_to_5deg_{name}"] = cycles_to_within(e["true_deg"], a.open_loop_cycles)

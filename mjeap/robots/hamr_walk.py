@@ -7,9 +7,12 @@ mjeap.robots.hamr_leg), trotting on a ground plane open loop at the paper's 200 
         [--loop-frequency 80] [--loop-amplitude 20] [--loop-cycles 40] [--loop-out ...] [--no-closed-loop]
 
 Prints JSON: per frequency the forward speed, the no-slip kinematic estimate, foot slip,
-body roll and pitch, penetration and wall time; the speed at 65 Hz beside the paper's
-0.5 m/s; the segment check and the steepest incline climbed at --record-frequency (not with
---quick); the closed_loop section (the eight phase loops against the open loop at
+body roll and pitch, duty factor and landings per cycle (also gathered in
+duty_factor_by_frequency), penetration, the chassis's and legs' lowest points and wall
+time; the speed at 65 Hz beside the paper's 0.5 m/s; the contact's sizing (contact); the
+rest check (rest: no drive, the feet's normal forces against the weight at every step), the
+segment check and the steepest incline climbed at --record-frequency (not with --quick);
+the closed_loop section (the eight phase loops against the open loop at
 --loop-frequency, --loop-amplitude). Writes a recording of the --record-frequency run and
 one of the closed loop. Written against mjeap's public
 component API (attach, System, ContactParameters, add_transmission) and plain MjSpec.
@@ -32,15 +35,25 @@ Model (host in mm, mg, ms; gravity along -z; x forward, y left, z up):
 - Actuators: eight pzt-hamr-small (piezo-bimorph drive, bias 200 V), clamped on the body
   (mount sites on it: the clamps ride with it), along x in the body's horizontal plane (their
   bending plane; gravity along their hinge axes), the front legs' pointing forward, the
-  rear legs' backward; ``contact=False``: only the feet touch the ground. SEGMENTS = 4 per
+  rear legs' backward; ``contact=False`` (the beams lie inside the chassis). SEGMENTS = 4 per
   actuator: against 20, the single leg's foot gain moves by -0.05 % (swing) and -0.1 %
   (lift) at 20 Hz, -0.4 % and -1.7 % at 65 Hz (2 segments: -1.2 % and -3.6 % at 65 Hz;
-  :func:`segment_effect`); the timestep (10.4 us) is set by the first mode either way.
-- Feet: spheres of FOOT_RADIUS = 0.5 mm (ASSUMED) on a ground plane, Coulomb friction
-  MU = 0.51 (the value of Doshi's HAMR trot simulations; a parameter), MuJoCo soft contact
-  from mjeap.simulation.system.ContactParameters (time constant 2 timesteps, critically damped,
-  elliptic cone, impratio 10 against creep); the solimp width, 0.1 x FOOT_RADIUS = 50 um,
-  is the contact tolerance of the penetration check.
+  :func:`segment_effect`, on the single leg). Integrator 'discrete' (INTEGRATOR): the feet's
+  contact forces reach the beams through the transmissions, and under 'implicitfast' MuJoCo
+  sizes contact impulses for M while the step integrates M + hD (see
+  mjeap.simulation.system.attach): with it the robot never came to rest (below). The step is
+  then the discrete integrator's beta / 2 = 4.51 us (beta = 2 zeta_1 / omega_1, the
+  actuator's first mode; 10.4 us under implicitfast), 2-3 x the wall time.
+- Ground contact: the feet (spheres of FOOT_RADIUS = 0.5 mm, ASSUMED), the chassis box and
+  the legs' rods and shanks touch the ground plane (nothing else touches anything): a robot
+  that rolls over lands on its chassis or legs. Coulomb friction MU = 0.51 (the value of
+  Doshi's HAMR trot simulations; a parameter), elliptic cone, impratio 10. MuJoCo's soft
+  contact sized from the robot's physics in :func:`contact_parameters`: time constant
+  CONTACT_STEPS = 10 steps = 45 us (at least 10 steps; 5 tau within 5 % of the shortest
+  stance, 5 ms at 100 Hz; a landing at v penetrates v tau / e, 17 um per m/s), critically
+  damped, solimp (0.99, 0.999, 50 um): at rest each foot sinks 0.56 nm and creeps 0.12 um/s
+  under the legs' splay. The solimp width, 0.1 x FOOT_RADIUS = 50 um, is the contact
+  tolerance of the penetration checks.
 
 Gait (trot): per actuator V = V_bias/2 + a sin(omega t + phi), a = AMPLITUDE = 100 V by
 default (full: the signal swings 0..200 V); the diagonal pairs (front-left + rear-right,
@@ -58,77 +71,120 @@ and pitch relative to the ground; stance: a foot within STANCE_GAP = 10 um of th
 whose tangential foot speed exceeds SLIDE_FRACTION = 10 % of the mean stance speed relative
 to the body; penetration; the no-slip kinematic estimate: the mean over time of the stance
 feet's backward speed relative to the body (foot path in the body frame), i.e. what the
-body would move if no stance foot slid; also the stance stroke, duty factor, stroke x f /
-duty.
+body would move if no stance foot slid; also the stance stroke, duty factor (the share of
+the samples with a foot in stance, per foot), stroke x f / duty, the landings per foot and
+cycle (stance onsets: ~1 a trot, more a foot bouncing, < 1 a body in flight), the lowest
+point of the chassis and of the legs over the run (:func:`clearances`). :func:`stand`: the
+robot with no drive, every step's normal forces against the weight, and its creep.
 
-Findings (4 segments, mu 0.51, MuJoCo 4.0; wall time 3.5-7 s per simulated second on 2
-shared cores). Re-measured after the fix of hamr_leg.add_leg's swing-stage and lift-lever
-centres of mass (commit 41b82c0: before it the robot's swing joints carried twice the
-design inertia, swing resonance 71 Hz, not 100), with :func:`walk` and :func:`walk_metrics`
-at their default windows; the motion is chaotic (a small change of mu or segments moves
-these numbers), so they are single runs, not converged values:
+Findings (4 segments, mu 0.51, MuJoCo 4.0, 2 shared cores: 11-19 s wall per simulated
+second, up to 29 beside another run), with :func:`walk` and :func:`walk_metrics` at their
+default windows. The motion is chaotic (a small change of mu or segments moves these
+numbers): single runs, not converged values. Re-measured with the contact of
+:func:`contact_parameters` (issue: the walker's contact); "before" is the 2-step contact
+under 'implicitfast', after hamr_leg's stage centre-of-mass fix (commit 41b82c0).
+- At rest (:func:`stand`, no drive, 1 s): after 0.5 s the feet's normal forces add up to the
+  weight within 6e-8 at every step, all four feet down at every step; the body moves along
+  the ground at 1e-10 m/s, each foot 0.12 um/s (the legs splay under the weight: 0.21 of
+  it sideways on each foot, held by the soft friction) and the body sinks 0.11 um/s with
+  them. Before: no foot touched in 40 % of the steps after 2.5 s, force spikes of 44-74 x
+  the weight, the body bounced 7.8 um peak to peak and crept 67 um. The cause was the
+  integrator, not the contact alone: under 'implicitfast' the 2-step contact chattered
+  (softer contacts, 5-100 steps, too: 9-24 % of the steps with no foot down), impratio 1
+  stilled it only after 0.45 s of chatter; under 'discrete' the 2-, 10- and 22-step
+  contacts all rest within 3e-6.
+- Rolled over: the chassis (and legs) now collide. Full drive at 20 / 65 / 100 Hz the robot
+  lands on its back: the chassis's lowest corner 0.3 / 9.7 / 0.1 um into the ground (before:
+  20 mm through it at 65 Hz, 2.5 at 80, 17.5 at 100); the legs 50 um (65 Hz) and 196 um
+  (100 Hz: legs flailing at the swing resonance, v tau / e at ~12 m/s) into it.
 - Full amplitude (the paper's drive): the feet move T x delta(200 V) = 3.5 mm (swing) and
   3.2 mm (lift) quasi-statically on a 10 mm leg, 6.1 and 9.4 mm at 65 Hz (dynamic gains 1.7
-  and 2.9). After the fix:
+  and 2.9):
 
-      f (Hz)   upright   speed (m/s)   no-slip est.   max |roll|, |pitch| (deg)   sliding
-        5       yes        0.081          0.069             7,  8                  75 %
-       10       yes        0.084          0.086            13, 11                  84 %
-       20       no         0.051          0.078            33, 13                  86 %
-       40       yes        0.156          0.232            24, 15                  89 %
-       65       no        (-0.13)         --               72, 61 (rolled over; body to 39 mm)
-     80, 100    no          --            --              180, 86 (on its back)
+      f (Hz)  upright  speed (m/s)  no-slip est.  max |roll|,|pitch|  sliding  duty   landings
+        5      yes       0.087         0.066          10, 11            74 %    0.34    2.4
+       10      yes       0.093         0.074          12, 11            86 %    0.33    1.9
+       20      no       (-0.16)                      108, 77 (rolled over)
+       40      no       (0.045)                       62, 70
+       65      no        --                          180, 43 (on its back)
+     80, 100   no        --                          180, 67-86 (on its back)
 
-  It trots upright at 5-10 Hz (the body rocking on its diagonal support and hopping on its
-  legs' lift compliance: k_foot = m_foot (2 pi 80 Hz)^2 = 9 N/m, the body bounces at 18 Hz
-  on two feet, 25 Hz on four, damped to zeta ~0.01) and, just, at 40 Hz; at 20 Hz it rocks
-  past UPRIGHT_DEG (33 deg) while still moving forward; from 65 Hz up it rolls over: no
-  speed at 65 Hz to set beside the paper's 0.5 m/s (mjeap.robots.hamr_walk_study: whatever
-  single model parameter is changed; the lift amplitude decides it: full swing with a 20 V
-  lift upright, 0.256 m/s; 30 V: 0.186 m/s; 40 V and up: thrown off its feet, the lift
-  transmission amplifying 2.9x at 65 Hz. Speed-frequency with full swing, lift 20 V: 5, 10,
-  20, 40, 65 Hz: 0.067, 0.146, 0.282, 0.251, 0.256 m/s, no-slip estimate 0.063, 0.135,
-  0.311, 0.392, 0.963; 80 and 100 Hz roll over). Before the fix: transmission damping
-  zeta 0.15 or 0.3 still rolled over at 65 Hz (not re-measured).
-- Reduced amplitude, after the fix: at 30 V (feet 1.0 mm quasi-static) 20 Hz: 0.093 m/s,
-  no-slip estimate 0.086 (9 % below; tested within 10 %), roll and pitch below 3 deg, 36 %
-  of the stance samples sliding; 65 Hz: 0.217 m/s (0.43 x the paper; no-slip estimate
-  0.331), roll and pitch 7 and 5 deg, a bounding gait (the body 13.4-15.6 mm high against
-  11.6-12.0 mm at 20 Hz). At 20 V the speed rises with frequency and stays upright: 20, 40,
-  65, 80 Hz: 0.053, 0.099, 0.232, 0.291 m/s (no-slip estimate 0.047, 0.100, 0.301, 0.331).
-  Before the fix the 20 V trot walked backward at 80 Hz (-0.30 m/s: the swing, at 71 Hz,
-  lagged past the lift); after it, it does not (see Closed loop).
-- The contact-force plot's spikes (measured before the fix: 18 N on FL's leg at t = 0.735 s
-  in the 10 Hz run, 1300x the weight): a foot striking the ground at 0.59 m/s (the body
-  rocking onto it), stopped within the contact's time constant (2 timesteps, 21 us): F ~
-  m_eff v / tau. The units are right (mj_contactForce in mg mm / ms^2 = 1 mN); the peak is
-  set by the numerical time constant, not a physical stiffness, and the plot samples the
-  instantaneous force every 2 ms, so it shows such a 20 us impact only when a sample falls
-  in it.
+  (duty: the share of the time each foot is in stance; landings: stance onsets per foot
+  and cycle.) Before: upright also at 40 Hz (0.156 m/s) and at 20 Hz rocking to 33 deg
+  (0.051 m/s); 5 and 10 Hz 0.081, 0.084. It trots upright at 5-10 Hz, a foot down 75-86 %
+  of the time (the body rocking on its diagonal support and hopping on its legs' lift
+  compliance, k_foot = m_foot (2 pi 80 Hz)^2 = 9 N/m: it bounces at 18 Hz on two feet, 25
+  Hz on four, damped to zeta ~0.01); from 20 Hz up it rolls over: no speed at 65 Hz to set
+  beside the paper's 0.5 m/s (mjeap.robots.hamr_walk_study: whatever single model parameter
+  is changed; the lift amplitude decides it: full swing with a 20 V lift upright, 0.196 m/s;
+  30 V: 0.183 m/s; 50 V 0.068 m/s at 20 / 16 deg; the full 100 V rolls over, the lift
+  transmission amplifying 2.9x at 65 Hz). Speed-frequency with full swing, lift 20 V:
+
+      f (Hz)             5      10      20      40      65      80      100
+      speed (m/s)      0.067   0.149   0.292   0.159   0.196   0.347   rolls over
+      no-slip est.     0.022   0.099   0.265   0.360   1.14   -0.18
+      upright           yes     yes     yes     yes     yes   no (42)
+      duty factor      0.82    0.61    0.51    0.21    0.035   0.012    0
+      a foot down      100 %   100 %   100 %    71 %    14 %     5 %    0
+      landings/cycle   0.6     1.6     1.3     2.2     0.44    0.19
+
+  (before: 0.067, 0.146, 0.282, 0.251, 0.256 m/s to 65 Hz; 80 and 100 Hz rolled over). A
+  walking trot to 20 Hz (duty factor above 0.5, a foot always down), a running trot at 40
+  Hz, and from 65 Hz a hopping gait: the body in flight 86-95 % of the time.
+- Why the trot hops (hamr_walk_study.contact_study): the gait, not the contact. At 80 Hz,
+  20 V (the lifts at their resonance, gain 1 / (2 zeta) = 10: a free foot would move +-6.4 mm
+  against the legs' static sag under the weight on two feet, W / (2 k_foot) = 0.78 mm) each
+  foot lands once every 4-8 cycles (0.13, 0.23, 0.25 landings per cycle with the time
+  constant at 2, 10, 50 steps; 0.17, 0.27, 0.20 under implicitfast) and the body flies 3-9
+  mm above its standing height between: the time constant changes only how long a landing
+  lasts (duty 0.0025, 0.0047, 0.016) and how deep it goes (2, 29, 191 um). Within a stance
+  the feet do not stay on the ground either: at 40 Hz (lift 20 V) each foot touches 4-60
+  times per cycle for 9-27 us (sampled every 2 steps), with the time constant at 2, 10 or
+  50 steps, under either cone, impratio 1 or 10, a stiffer transmission equality (solref 2
+  steps, solimp 0.99) and mu 0.1; frictionless (mu 0) they stay down for 0.1-7 ms at a time. MuJoCo's soft friction does
+  this: it resolves a sliding contact's normal and friction in one cost, and a sliding
+  contact is pushed apart (a 0.5 mm sphere on slide joints, driven to slide at 0.06-0.3 m/s
+  on this contact, touches in under 1 % of the steps, hovering 2-60 um up; at mu 0, 98 %).
+  The feet slide through most of their stance (74-91 % of the stance samples at full drive,
+  21-97 % at 20-30 V), so they hover microns above the ground: the stance is read from the
+  clearance (STANCE_GAP), not from MuJoCo's contact list.
+- Literature: Doshi et al. 2019 (arXiv 1901.08715; its abstract, read on ar5iv) track leg
+  trajectories closed loop "across a wide range of stride frequencies (10 Hz to 50 Hz)",
+  find the robot's natural dynamics give "poor open-loop locomotion" at 10-30 Hz, and reach
+  "minimal leg slippage (10 %)" (the sign before it lost in that rendering) and a cost of
+  transport of 3.33 with trajectories designed to reduce slip. This open-loop sine trot
+  slides through 74-91 % of its stance samples at full drive, 21-27 % at 20-30 V and 20 Hz.
+  Goldberg, Doshi, Jayaram and Wood 2017 (Bioinspir. Biomim., HAMR's gaits, speeds and body
+  natural frequencies over stride frequency) was not readable here: not compared.
+- Reduced amplitude: at 30 V (feet 1.0 mm quasi-static) 20 Hz: 0.095 m/s, no-slip estimate
+  0.086 (+9.96 %: within the tested 10 %, barely; before, +9 %), roll and pitch below 3
+  deg, 27 % of the stance samples sliding, a foot always down, duty 0.51; 65 Hz: 0.175 m/s (0.35 x the paper; no-slip
+  estimate 0.40), roll and pitch 9 and 11 deg, duty 0.024. At 20 V: 20, 40, 65, 80 Hz:
+  0.053, 0.101, 0.149, 0.266 m/s (no-slip estimate 0.045, 0.109, 0.29, 0.36), duty 0.63,
+  0.45, 0.035, 0.005; upright to 65 Hz, at 80 Hz pitching to 33 deg in its hops (before:
+  0.053, 0.099, 0.232, 0.291, upright).
+- Contact forces: a landing foot is stopped within the contact's time constant, F ~ m_eff
+  v / tau; the recording pictured (10 Hz) peaks at 0.22 N (16 x the weight; before, 0.4 N),
+  the 40 Hz trot's landings reach 210 x the weight over 10-20 us. The units are right
+  (mj_contactForce in mg mm / ms^2 = 1 mN); the plot samples the force every 2 ms.
 - Closed loop (:func:`walk_closed_loop`: the single leg's phase loops on all eight
   actuators, each reading only its own drive current through the estimator calibrated on
   the free actuator at 200 V and 4 segments; gains from phase_loop_gains at the trot
   frequency; the transmissions' sweep on the 4-segment leg at 200 V fits 99.8 Hz and 79.8
   Hz, zeta 0.052, the model's 100 / 80 Hz, 0.05), at 20 V, 80 Hz (the lifts' resonance,
   where their open-loop lag is largest: the second-order model's 90 deg, the swings' 12.5),
-  after the fix, 40 cycles closed after 6: open loop (cycles 4-39) the lifts lag 70.5-75.6
-  deg (less than 90: stance adds the ground's stiffness to the lift) and the swings
-  15.3-21.3 deg, each with a per-cycle scatter of 8-15 deg sd; closed, each foot's true
-  error over cycles 16-39 averages -0.9..+4.4 deg (standard error of that mean 1.6-3.2
-  deg), but scatters 8-15 deg sd from cycle to cycle (the stance impacts and the body's
-  bounce move the foot relative to the body): no foot holds 5 deg every cycle (four come
-  within it only over the last cycles). The sensed
-  error follows the true one on average within 2.6 deg. The open loop walks forward here
-  (+0.35 m/s over the last 16 cycles, upright), faster than the closed loop (+0.30 m/s,
-  upright): the loops correct the feet's phase, not the speed. Before the fix the open loop
-  walked backward (-0.48 m/s) and the loop turned it forward; after it no drive near the
-  lift resonance shows that: at 85 and 90 Hz (lifts lagging 102-110 and 118-128 deg) the
-  open loop walks forward too (+0.30, +0.55 m/s), and the closed loop leaves the lifts' mean
-  error at 5-10 and 13-33 deg. 80 Hz stays the demonstration: the largest lift lag whose
-  loop settles.
-- Incline (the ground tilted, gravity along -z), after the fix: full amplitude at 10 Hz
-  climbs 8 deg (0.005 m/s), not 12 (-0.13 m/s); 30 V at 20 Hz climbs 8 deg (0.066 m/s), not
-  12 (-0.063 m/s) (the paper: nearly 22 deg).
+  40 cycles closed after 6: see tests/test_hamr_walk_loops.py for the lags and errors. At
+  80 Hz, 20 V the robot hops (above): a foot down 5 % (open loop) and 1.4-8 % (closed, two
+  runs, the self-sensing controllers changed between them) of the time, duty 0.013 and
+  0.003-0.021, and in its flights it tilts past UPRIGHT_DEG (open loop pitch 32 deg; closed
+  roll 37 in one run, 17 / 24 in the other) without rolling over; the open loop +0.41 m/s,
+  the closed +0.18-0.19 m/s (before: +0.35 and +0.30, upright): the loops correct the
+  feet's phase, not the speed. Each foot's true error over cycles 16-39 averages
+  -2.5..+4.0 deg, scattering 7-30 deg from cycle to cycle (the landings move the foot
+  relative to the body); the sensed error follows the true one on average within 1.9 deg.
+- Incline (the ground tilted, gravity along -z): full amplitude at 10 Hz climbs 8 deg
+  (0.007 m/s), not 12 (-0.12 m/s); 30 V at 20 Hz and the 20 V lift at 65 Hz: 8 deg (the
+  paper: nearly 22 deg); friction-limited (hamr_walk_study.incline_study).
 """
 from __future__ import annotations
 
@@ -141,6 +197,7 @@ import mujoco
 import numpy as np
 
 from ..cli import arg_integer, arg_number, arg_output, parse_args, run_script
+from ..io.outputs import run_guard
 from ..drives.waveforms import parse_waveform
 from ..errors import ParameterError, check_integer, check_range
 from ..simulation.system import ContactParameters, System, attach
@@ -157,7 +214,12 @@ FOOT_DROP = 11.35e-3            # m, the foot below its leg frame in Doshi's HAM
 FOOT_RADIUS = 0.5e-3            # m, assumed
 MU = 0.51                       # sliding friction, as Doshi's HAMR trot simulations (see the module text)
 CONTACT_WIDTH_FRACTION = 0.1    # solimp width as a fraction of FOOT_RADIUS: the penetration tolerance
-IMPRATIO = 10.0
+IMPRATIO = 10.0                 # the friction rows' regulariser / 10: a sticking foot creeps 10 x less
+#: the contact's time constant in timesteps (contact_parameters: 10 h = 45 us at 4 segments)
+CONTACT_STEPS = 10.0
+#: the actuators' integrator: the feet's contact forces reach the beams through the
+#: transmissions, and 'implicitfast' sizes them for M alone (the feet chatter at rest)
+INTEGRATOR = "discrete"
 BIAS = 200.0                    # V, HAMR's drive bias (the brief's "paper's 200 V")
 AMPLITUDE = 0.5 * BIAS          # V, full amplitude: the signal swings 0..V_bias
 SEGMENTS = 4
@@ -183,7 +245,8 @@ SLIDE_FRACTION = 0.1            # a contact foot slides above this fraction of i
 
 def build(mu: float = MU, segments: int = SEGMENTS, bias: float = BIAS, incline_deg: float = 0.0,
           d: Optional[dict] = None, armature_fraction: float = 0.0, foot_drop: float = FOOT_DROP,
-          body_width: float = BODY_WIDTH, timeconst_steps: float = 2.0) -> System:
+          body_width: float = BODY_WIDTH, timeconst_steps: float = CONTACT_STEPS,
+          upside_down: bool = False, integrator: str = INTEGRATOR) -> System:
     """The robot as a System (host in mm, mg, ms) standing on a ground plane tilted by
     ``incline_deg`` about y (uphill along +x); ``d``: hamr_leg.design() (computed if None).
 
@@ -195,7 +258,10 @@ def build(mu: float = MU, segments: int = SEGMENTS, bias: float = BIAS, incline_
     body's own mass takes up the rest: the robot still weighs TOTAL_MASS); ``foot_drop`` (m):
     the foot below the leg rod's end (its lateral motion per radian of lift); ``body_width``
     (m): the chassis width, the hips at its sides; ``timeconst_steps``: the contact's time
-    constant in timesteps (ContactParameters)."""
+    constant in timesteps (ContactParameters; CONTACT_STEPS, see :func:`contact_parameters`).
+    ``upside_down``: the body starts turned 180 degrees about x, its chassis 20 um above the
+    ground (the rolled-over robot). ``integrator``: the actuators' ('discrete', INTEGRATOR:
+    the feet's contacts reach the beams through the transmissions, see the module text)."""
     mu = check_range("mu", mu, 0.0, 10.0)
     segments = check_integer("segments", segments, 1, 40)
     incline = np.radians(check_range("incline_deg", incline_deg, -45.0, 45.0, "deg"))
@@ -203,6 +269,8 @@ def build(mu: float = MU, segments: int = SEGMENTS, bias: float = BIAS, incline_
     foot_drop = check_range("foot_drop", foot_drop, 0.0, 0.05, "m")
     body_width = check_range("body_width", body_width, 6e-3, 0.1, "m")
     timeconst_steps = check_range("timeconst_steps", timeconst_steps, 2.0, 100.0)
+    if integrator not in ("discrete", "implicitfast"):
+        raise ParameterError("integrator", integrator, "'discrete' or 'implicitfast'")
     d = design() if d is None else d
     if armature_fraction:
         d = {n: {**v, "joint_inertia_kg_m2": v["joint_inertia_kg_m2"] * (1.0 - armature_fraction)}
@@ -218,10 +286,17 @@ def build(mu: float = MU, segments: int = SEGMENTS, bias: float = BIAS, incline_
     hip_height = (foot_drop + FOOT_RADIUS) * mm + 0.02          # feet 20 um above the ground at the start
     R_ground = np.zeros(9)
     mujoco.mju_quat2Mat(R_ground, np.array(q_ground))
-    body = wb.add_body(name="body", pos=(R_ground.reshape(3, 3) @ [0, 0, hip_height]).tolist(), quat=q_ground)
+    q_body = np.array(q_ground)
+    if upside_down:             # turned about x: the chassis (its top down) 20 um above the ground
+        hip_height = H + 0.02
+        mujoco.mju_mulQuat(q_body, np.array(q_ground), np.array([0.0, 1.0, 0.0, 0.0]))
+    body = wb.add_body(name="body", pos=(R_ground.reshape(3, 3) @ [0, 0, hip_height]).tolist(), quat=q_body.tolist())
     body.add_freejoint(name="root")
+    # the chassis touches the ground (contype 1; the ground's conaffinity 1), nothing else: a
+    # robot that rolls over lands on it
     box = body.add_geom(name="chassis", type=mujoco.mjtGeom.mjGEOM_BOX, size=[L / 2, W / 2, H / 2], pos=[0, 0, H / 2],
-                        mass=TOTAL_MASS * 1e6 / 2, rgba=[0.25, 0.3, 0.4, 0.5], contype=0, conaffinity=0)
+                        mass=TOTAL_MASS * 1e6 / 2, rgba=[0.25, 0.3, 0.4, 0.5], contype=1, conaffinity=0,
+                        condim=3)
     acts = {}
     for leg, (fore, side, _) in LEGS.items():
         for k, dof in enumerate(("swing", "lift")):
@@ -229,11 +304,16 @@ def build(mu: float = MU, segments: int = SEGMENTS, bias: float = BIAS, incline_
             site = body.add_site(name=f"{leg}_{dof}_mount", pos=[fore * 2.0, side * (2.5 + 3.0 * k), H - 1.0 - 2.0 * k],
                                  quat=[1, 0, 0, 0] if fore > 0 else [0, 0, 0, 1])
             acts[f"{leg}_{dof}"] = attach(spec, ACTUATOR, site=site.name, prefix=f"{leg}_{dof}", contact=False,
-                                          drive_params={"bias": bias}, segments=segments)
+                                          drive_params={"bias": bias}, segments=segments, integrator=integrator)
     for leg, (fore, side, _) in LEGS.items():
         add_leg(spec, body, {dof: acts[f"{leg}_{dof}"] for dof in ("swing", "lift")}, d, prefix=f"{leg}/",
                 pos=[fore * HIP_X * mm, side * W / 2, 0.0], side=side, mass_radius=LEG_LENGTH * mm,
                 foot_drop=foot_drop * mm, foot_radius=FOOT_RADIUS * mm, foot_contact=True)
+        # the leg rod and the shank touch the ground too (a robot on its side lies on them)
+        for part in ("leg", "shank"):
+            g = spec.geom(f"{leg}/{part}")
+            if g is not None:
+                g.contype, g.conaffinity, g.condim = 1, 0, 3
         if armature_fraction:
             u0 = acts[f"{leg}_swing"].twin.units
             for dof in ("swing", "lift"):
@@ -250,11 +330,61 @@ def build(mu: float = MU, segments: int = SEGMENTS, bias: float = BIAS, incline_
     acts_list = list(acts.values())
     u = acts_list[0].twin.units
     h = min(a.twin.timestep for a in acts_list)
-    contact = ContactParameters(friction=(mu, 5e-6, 1e-7), impratio=IMPRATIO, width_fraction=CONTACT_WIDTH_FRACTION,
-                                timeconst_steps=timeconst_steps)
+    contact = contact_parameters(h, mu, timeconst_steps)
     # System applies contact parameters only for actuators with contact: here the feet's
     contact.apply(spec, h / u.time, FOOT_RADIUS / u.length, u.length)
     return System(spec, acts_list, contact=contact)
+
+
+def contact_parameters(h: float, mu: float = MU, timeconst_steps: float = CONTACT_STEPS) -> ContactParameters:
+    """The feet's (and the chassis's) contact with the ground for a timestep ``h`` (s),
+    sized from the robot's physics: the window below (:func:`contact_sizing` gives its
+    numbers for a built robot; other ``timeconst_steps`` are for studies,
+    hamr_walk_study.contact_study).
+
+    solref = (tau, 1), tau = CONTACT_STEPS h = 45 us at the walker's h = 4.51 us (the
+    discrete integrator's beta / 2, beta = 2 zeta_1 / omega_1 of the actuator's first mode;
+    4.4-4.5 us for 2-20 segments). Critically damped: a landing foot does not rebound off
+    the contact itself (its penetration obeys r'' + 2 r' / tau + r / tau^2 = 0). The window:
+    - tau >= 10 h: MuJoCo integrates the contact's reference dynamics over the steps; at
+      its floor, 2 h, the normal and friction rows are deadbeat from one step to the next
+      (a projection, not a resolved response; under 'implicitfast' the 2-step contact left
+      the robot at rest with no foot down in 40 % of the steps, though the integrator was
+      the cause: under 'discrete' it rests, module text);
+    - 5 tau (the critically damped response within 4 %) <= 5 % of the shortest stance, half
+      a cycle at the command line's top frequency (100 Hz: 5 ms): tau <= 50 us;
+    - a foot landing at v penetrates at most v tau / e: 23 um at the 1.4 m/s landings of the
+      80 Hz, 20 V hops, within the solimp width (the contact tolerance, 50 um = 0.1 x the
+      foot radius; tau <= 97 us there).
+    solimp (dmin 0.99, dmax 0.999, width 50 um): at rest a foot carrying a quarter of the
+    weight (3.5 mN) on its effective mass (156 mg, MuJoCo's diagonal of the contact's
+    inverse inertia) sinks (1 - d) / d^2 x tau^2 F / m = 0.46 nm (0.56 measured, MuJoCo's
+    discrete step); as a spring that is 6e6 N/m against the legs' 9 N/m (k_foot: the body
+    bounces at 18-25 Hz on its legs, not on the contact). Friction: mu, elliptic cone,
+    impratio IMPRATIO: a sticking foot under a tangential force f creeps at about
+    (1 - d) / d x (f / m) x dmax tau / (2 impratio) (the legs splay under the weight, 0.21 of
+    it sideways on each foot: 0.12 um/s; impratio 1 would make it 10 x more)."""
+    steps = check_range("timeconst_steps", timeconst_steps, 2.0, 100.0)
+    return ContactParameters(friction=(mu, 5e-6, 1e-7), impratio=IMPRATIO, width_fraction=CONTACT_WIDTH_FRACTION,
+                             timeconst_steps=steps)
+
+
+def contact_sizing(system: System) -> dict:
+    """The numbers behind :func:`contact_parameters` for a built ``system`` (SI): the step,
+    the time constant (s and steps), 5 tau against the shortest stance (half a cycle at
+    FREQUENCY_RANGE's top), the penetration per m/s of landing speed (tau / e) against the
+    contact tolerance, and the landing speed at which they meet."""
+    o = system.model.opt
+    u = system.units
+    tau = float(o.o_solref[0]) * u.time
+    stance = 0.5 / FREQUENCY_RANGE[1]
+    tol = CONTACT_WIDTH_FRACTION * FOOT_RADIUS
+    return {"timestep_s": system.timestep, "timeconst_s": tau, "timeconst_steps": tau / system.timestep,
+            "dampratio": float(o.o_solref[1]), "solimp": [float(x) for x in o.o_solimp[:3]] + [float(o.o_solimp[3]),
+                                                                                             float(o.o_solimp[4])],
+            "shortest_stance_s": stance, "settling_5tau_over_stance": 5 * tau / stance,
+            "landing_penetration_m_per_m_s": tau / np.e, "contact_tolerance_m": tol,
+            "landing_speed_at_tolerance_m_s": tol * np.e / tau, "impratio": float(o.impratio)}
 
 
 class SoftStart:
@@ -313,6 +443,30 @@ def ground_rotation(system: System) -> np.ndarray:
     return system.data.geom("ground").xmat.reshape(3, 3).copy()
 
 
+def clearances(system: System) -> tuple:
+    """The lowest point (m) above the ground plane of the chassis (its box's corners) and of
+    the legs (their rods' and shanks' capsules): negative where it is below the ground."""
+    m, d = system.model, system.data
+    g = d.geom("ground")
+    up, origin = g.xmat.reshape(3, 3)[:, 2], g.xpos
+    c = d.geom("chassis")
+    size = m.geom("chassis").size
+    corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * size
+    chassis = float(((c.xpos + corners @ c.xmat.reshape(3, 3).T - origin) @ up).min())
+    legs = np.inf
+    for leg in LEGS:
+        for part in ("leg", "shank"):
+            gid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, f"{leg}/{part}")
+            if gid < 0:
+                continue
+            r, half = m.geom_size[gid, 0], m.geom_size[gid, 1]
+            axis = d.geom_xmat[gid].reshape(3, 3)[:, 2]
+            ends = d.geom_xpos[gid] + np.outer([-half, half], axis)
+            legs = min(legs, float(((ends - origin) @ up).min() - r))
+    u = system.units.length
+    return chassis * u, legs * u
+
+
 def roll_pitch(R: np.ndarray, G: np.ndarray) -> tuple:
     """Roll and pitch (rad) of a body rotation ``R`` relative to the ground's ``G``."""
     Rr = G.T @ R
@@ -334,12 +488,14 @@ def walk(system: System, frequency: float, amplitude: float = AMPLITUDE, settle:
     cycles, see SETTLE and MEASURE_*), or under ``controller`` (a system controller, e.g.
     :class:`TrotPhaseControllers`, see :func:`walk_closed_loop`). Returns the samples (SI,
     world): time, body position and rotation, the feet's positions and velocities, which feet touch the ground, the
-    deepest penetration; the rollout's result; the measuring window's start ``t0``."""
+    deepest penetration, the chassis's and the legs' lowest points above the ground
+    (:func:`clearances`); the rollout's result; the measuring window's start ``t0``."""
     bias = system.actuators[0].drive.params["bias"]
     settle, measure = _durations(frequency, settle, measure)
     fid = [mujoco.mj_name2id(system.model, mujoco.mjtObj.mjOBJ_GEOM, f"{leg}/foot") for leg in LEGS]
     sid = [mujoco.mj_name2id(system.model, mujoco.mjtObj.mjOBJ_SITE, f"{leg}/foot") for leg in LEGS]
-    rows = {k: [] for k in ("body", "R", "feet", "feet_velocity", "contact", "penetration")}
+    rows = {k: [] for k in ("body", "R", "feet", "feet_velocity", "contact", "penetration", "chassis_clearance",
+                            "leg_clearance")}
     v6 = np.zeros(6)
 
     def on_sample(sy):
@@ -355,6 +511,9 @@ def walk(system: System, frequency: float, amplitude: float = AMPLITUDE, settle:
         touching = {d.contact[i].geom1 for i in range(d.ncon)} | {d.contact[i].geom2 for i in range(d.ncon)}
         rows["contact"].append([g in touching for g in fid])
         rows["penetration"].append(sy.penetration())
+        low = clearances(sy)
+        rows["chassis_clearance"].append(low[0])
+        rows["leg_clearance"].append(low[1])
 
     volts = None if controller is not None else trot_voltages(frequency, amplitude, bias, lift_amplitude=lift_amplitude)
     res = system.rollout(volts, settle + measure, sample_interval=1.0 / (samples_per_cycle * frequency),
@@ -364,6 +523,66 @@ def walk(system: System, frequency: float, amplitude: float = AMPLITUDE, settle:
                lift_amplitude=float(amplitude if lift_amplitude is None else lift_amplitude),
                t0=float(settle), ground=ground_rotation(system))
     return run
+
+
+def stand(system: System, duration: float = 1.0, after: float = 0.5, window: float = 0.1) -> dict:
+    """No drive (every actuator held at its rest voltage) for ``duration`` s from the start
+    (feet or, upside down, the chassis 20 um above the ground). At every step after
+    ``after`` s: the sum of the normal forces of the ground's contacts against the robot's
+    weight (relative error; the largest), the steps with no foot down. The creep: the mean
+    positions over the first and last ``window`` s after ``after`` (at most a quarter of
+    the checked time each), their horizontal
+    distance over the time between (body and each foot, m/s), and the body's vertical
+    drift. SI; stepped with mj_step (one step at a time, to read every step's forces)."""
+    duration = check_range("duration", duration, 0.0, 10.0, "s", lo_open=True)
+    after = check_range("after", after, 0.0, duration, "s", hi_open=True)
+    window = min(check_range("window", window, 0.0, 10.0, "s", lo_open=True), 0.25 * (duration - after))
+    m, d = system.model, system.data
+    u = system.units
+    system.reset()
+    h = system.timestep
+    n = int(round(duration / h))
+    k0 = int(np.ceil(after / h - 1e-9))
+    ground = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "ground")
+    fid = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, f"{leg}/foot") for leg in LEGS]
+    sid = [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, f"{leg}/foot") for leg in LEGS]
+    bid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "body")
+    weight = float(m.body_subtreemass[bid] * np.linalg.norm(m.opt.gravity)) * u.force
+    fn = np.zeros(n - k0)
+    down = np.zeros(n - k0, dtype=int)
+    pos = np.zeros((n - k0, 5, 3))
+    f6 = np.zeros(6)
+    for k in range(n):
+        mujoco.mj_step(m, d)
+        if k < k0:
+            continue
+        i = k - k0
+        total, feet_down = 0.0, set()
+        for c in range(d.ncon):
+            con = d.contact[c]
+            if ground not in (con.geom1, con.geom2):
+                continue
+            mujoco.mj_contactForce(m, d, c, f6)
+            total += f6[0]
+            other = con.geom2 if con.geom1 == ground else con.geom1
+            if other in fid and f6[0] > 0:
+                feet_down.add(other)
+        fn[i], down[i] = total * u.force, len(feet_down)
+        pos[i, 0] = d.xpos[bid]
+        pos[i, 1:] = d.site_xpos[sid]
+    mujoco.mj_kinematics(m, d)
+    t = (np.arange(k0, n) + 1) * h
+    a, b = t < t[0] + window, t > t[-1] - window
+    span = t[b].mean() - t[a].mean()
+    drift = (pos[b].mean(axis=0) - pos[a].mean(axis=0)) * u.length / span          # (5, 3) m/s
+    err = fn / weight - 1.0
+    return {"weight_n": weight, "checked_from_s": float(t[0]), "steps_checked": int(n - k0),
+            "max_force_error": float(np.abs(err).max()), "mean_force_error": float(err.mean()),
+            "steps_with_no_foot_down": int((down == 0).sum()), "min_feet_down": int(down.min()),
+            "body_creep_m_s": float(np.hypot(*drift[0, :2])), "body_vertical_drift_m_s": float(drift[0, 2]),
+            "feet_creep_m_s": [float(np.hypot(*v[:2])) for v in drift[1:]],
+            "body_height_m": float(pos[-1, 0, 2] * u.length),
+            "body_height_range_m": float(np.ptp(pos[:, 0, 2]) * u.length)}
 
 
 def walk_metrics(run: dict) -> dict:
@@ -407,6 +626,11 @@ def walk_metrics(run: dict) -> dict:
         "body_height_range_m": [float((p @ up).min()), float((p @ up).max())],
         "max_penetration_m": float(run["penetration"].max()),
         "contact_tolerance_m": CONTACT_WIDTH_FRACTION * FOOT_RADIUS,
+        # stance onsets per foot per cycle: ~1 a trot, several a foot bouncing, < 1 a body in flight
+        "touchdowns_per_cycle": float(((~c[:-1]) & c[1:]).sum() / 4 / (duration * f)),
+        # over the whole run (a roll-over may come before the window): below 0, through the ground
+        "min_chassis_clearance_m": float(np.min(run["chassis_clearance"])),
+        "min_leg_clearance_m": float(np.min(run["leg_clearance"])),
         "measured_s": float(duration), "simulated_s": float(t[-1]),
         "wall_time_s": float(run["result"].meta["wall_time_s"]),
         "wall_s_per_simulated_s": float(run["result"].meta["wall_time_s"] / t[-1]),
@@ -732,7 +956,14 @@ def model_summary(system: System) -> dict:
                       "foot 11.35 mm below its leg frame, mu 0.51, drive ramped over 2 cycles":
                           "N. Doshi's HAMR Drake simulation scripts (HamrRBM FOOT_POS, trot sweeps MU)"},
             "assumed": ["body width and height", "hip spacing", "leg length (hamr_leg)", "foot radius",
-                        "the legs' mass radius (= leg length)", "contact: MuJoCo soft, elliptic cone, impratio 10"]}
+                        "the legs' mass radius (= leg length)",
+                        "contact: MuJoCo soft, elliptic cone, impratio 10, sized by contact_parameters"]}
+
+
+def _check_outputs(a) -> None:
+    """The recordings are two distinct files (a shared path would overwrite the first)."""
+    from ..io.outputs import check_outputs
+    check_outputs(**{"--out": a.out, "--loop-out": None if a.no_closed_loop else a.loop_out})
 
 
 def main(argv=None):
@@ -756,8 +987,16 @@ def main(argv=None):
                     help="recording of the closed-loop trot (.rrd)")
     ap.add_argument("--no-closed-loop", action="store_true", help="skip the closed-loop trot")
     ap.add_argument("--quick", action="store_true",
-                    help="skip the segment check and the incline search (at --record-frequency)")
-    a = parse_args(ap, argv)
+                    help="skip the rest check, the segment check and the incline search (at --record-frequency)")
+    a = parse_args(ap, argv, _check_outputs)
+    # the recordings locked before any work (a second run on them is refused); each study's
+    # recording is written as soon as it is done, so Ctrl-C or SIGTERM keeps it
+    with run_guard(**{"--out": a.out, "--loop-out": None if a.no_closed_loop else a.loop_out}):
+        return _experiments(a)
+
+
+def _experiments(a) -> None:
+    """The command line's studies (:func:`main`), its outputs already held."""
     d = design()
     system = build(a.mu, a.segments, d=d)
     out = {"model": model_summary(system), "amplitude_v": a.amplitude, "bias_v": BIAS, "mu": a.mu, "runs": []}
@@ -790,9 +1029,15 @@ def main(argv=None):
     out["kinematic_check"] = {"frequency_hz": low["frequency_hz"], "speed_m_s": low["speed_m_s"],
                               "no_slip_estimate_m_s": k, "relative_error": None if not k else low["speed_m_s"] / k - 1.0}
     out["wall_s_per_simulated_s"] = float(np.mean([r["wall_s_per_simulated_s"] for r in out["runs"]]))
+    # per frequency: the share of the time a foot is down (per foot), a foot at all, the landings per cycle
+    out["duty_factor_by_frequency"] = {f"{r['frequency_hz']:g}": {
+        "duty_factor": r["duty_factor"], "time_with_a_foot_down": r["time_with_a_foot_down"],
+        "touchdowns_per_cycle": r["touchdowns_per_cycle"], "upright": r["upright"]} for r in out["runs"]}
+    out["contact"] = contact_sizing(system)
     if not a.no_closed_loop:
         out["closed_loop"] = closed_loop_section(system, a.loop_frequency, a.loop_amplitude, a.loop_cycles, a.loop_out)
     if not a.quick:
+        out["rest"] = stand(system)         # no drive: the feet carry the weight at every step, no creep
         out["segment_effect"] = segment_effect()
         out["incline"] = max_incline(a.record_frequency, a.amplitude, a.mu, a.segments)
     out["recording"] = a.out

@@ -13,9 +13,9 @@ from typing import List, Optional, Sequence, Union
 import numpy as np
 
 from .accuracy import GRID_SAMPLES, target_for
-from ..engines import ENGINES, choose
+from ..engines import ENGINES, choose, run_checked
 from .periodic import MIN_SAMPLES_PER_PERIOD, PeriodicStop, check_periodic_stop
-from ..engines.frame import (Decided, DEFAULT_SAMPLES, MAX_INITIAL_BEND, MAX_STEPS, RolloutResult, Samples, check_initial_curvature, check_sampling, check_work, one_voltage, sample_steps, to_waveform, voltage_steps)
+from ..engines.frame import (Decided, DEFAULT_SAMPLES, MAX_INITIAL_BEND, MAX_STEPS, RolloutResult, Samples, check_controller, check_initial_curvature, check_sampling, check_work, one_voltage, sample_steps, to_waveform, voltage_steps)
 from ..errors import ParameterError, check_integer, check_positive
 from ..io.outputs import check_outputs, guarded, write_outputs
 from .scene import Scene
@@ -54,7 +54,11 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
             estimate_error: bool = False, error_model=None,
             stop_when_periodic: Optional[float] = None) -> RolloutResult:
     """Run ``scene`` driven by ``drive`` (name, instance or None for the actuator's own)
-    with ``voltage`` (waveform text, :class:`Waveform` or callable v(t)) for ``duration`` s.
+    with ``voltage`` (waveform text, :class:`Waveform` or callable v(t)) for ``duration`` s,
+    or closed loop under ``controller`` (``voltage`` then None): a callable
+    ``controller(t, scene) -> V``, a plain function or an object, with optional ``reset``,
+    ``interval``, ``name`` and ``signals`` (the one contract of rollout and System.rollout,
+    :func:`mjeap.engines.frame.check_controller`).
 
     The beam starts at rest as a uniform arc of ``initial_curvature`` (1/m). Returns SI
     arrays sampled every ``sample_interval`` s (default: at most 5001 evenly spaced samples, the
@@ -86,6 +90,7 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     from ..io import recording
 
     duration = check_positive("duration", duration, "s")
+    ctrl_name = None if controller is None else check_controller(controller, voltage)
     initial_curvature = check_initial_curvature(initial_curvature, scene.layout.length)
     wave = None if controller is not None else to_waveform(voltage, duration)
     drv = drive if (drive is not None and not isinstance(drive, str)) else \
@@ -119,12 +124,12 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
             "load): the run starts from that unstable equilibrium and only a disturbance (an initial curvature, a "
             "voltage) makes it buckle; a result near zero here is not a stable beam")
     if controller is not None:
-        meta["controller"] = getattr(controller, "name", type(controller).__name__)
+        meta["controller"] = ctrl_name
     error = None
     wall0 = _time.perf_counter()
     try:
-        eng.run(scene, [drv], [v_steps], [initial_curvature], steps, [samples], progress=progress,
-                check_every=check_every, controller=controller, meta=meta)
+        run_checked(eng, scene, [drv], [v_steps], [initial_curvature], steps, [samples], progress=progress,
+                    check_every=check_every, controller=controller, meta=meta)
     except Decided as stop:     # a finished run that ends early: its result, not an error
         meta["stopped_early"], meta["steps_run"] = stop.reason, stop.step
     except BaseException as e:  # record what was simulated, then re-raise
@@ -249,7 +254,7 @@ def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable
     part = eng.part(scene, drives[0])
     samples = [Samples(part, len(steps)) for _ in voltages]
     wall0 = _time.perf_counter()
-    eng.run(scene, drives, v_steps, list(kappa0), steps, samples, nthread=nthread)
+    run_checked(eng, scene, drives, v_steps, list(kappa0), steps, samples, nthread=nthread)
     wall = _time.perf_counter() - wall0
     out = []
     for w, d, k0, smp in zip(waves, drives, kappa0, samples):

@@ -74,6 +74,14 @@ NEAR_CRITICAL = 0.01
 #: a payload heavier than this many beams is probably a unit slip (kg for mg, a factor 1e6):
 #: warned. The HAMR leg's reflected leg mass is 4.7e4 beams (controllers/hamr_leg.py)
 HEAVY_PAYLOAD = 1e5
+
+
+def warn_heavy_payload(mass: float, beam_mass: float, what: str = "payload", stacklevel: int = 3) -> None:
+    """The one check of a payload's unit (the Scene's, the environments' drawn masses): a
+    warning where ``mass`` (kg) exceeds HEAVY_PAYLOAD x the beam's ``beam_mass``."""
+    if mass > HEAVY_PAYLOAD * beam_mass:
+        warnings.warn(f"{what} {mass:.4g} kg is {mass / beam_mass:.3g} x the beam's mass ({beam_mass:.3g} kg): "
+                      "check its unit (SI is kg; '12.6mg' for milligrams)", stacklevel=stacklevel)
 #: tip angle (rad) of the uniform arc at which the cable's stability limit is checked
 #: besides the straight beam; seed 000's actuator bends to about 1.8 rad
 DEFAULT_MAX_BEND = 2.0
@@ -166,9 +174,8 @@ class Scene:
         self.layout: BeamLayout = discretize(self.actuator, segments)
         check_payload(payload, self.layout)
         beam_mass = float(self.layout.link_mass.sum())
-        if payload is not None and payload.mass > HEAVY_PAYLOAD * beam_mass:
-            warnings.warn(f"payload {payload.mass:.4g} kg is {payload.mass / beam_mass:.3g} x the beam's mass "
-                          f"({beam_mass:.3g} kg): check its unit (SI is kg; '12.6mg' for milligrams)", stacklevel=2)
+        if payload is not None:
+            warn_heavy_payload(payload.mass, beam_mass)
         zeta = self.actuator.damping_ratio.value if damping_ratio is None else \
             check_range("damping_ratio", damping_ratio, 0.0, 10.0)
         self.rotation = clamp_rotation(orientation)
@@ -405,14 +412,19 @@ class Scene:
 
     def divergence_error(self) -> DivergenceError:
         """The error for a run that blew up by the present step: which scene, when, the
-        timestep against its stability limit and the mode that sets it."""
+        timestep against its stability limit and the mode that sets it; a payload heavier than
+        HEAVY_PAYLOAD beams (its unit) is named."""
         c = self.choice
+        beam_mass = float(self.layout.link_mass.sum())
+        heavy = self.payload is not None and self.payload.mass > HEAVY_PAYLOAD * beam_mass
         return DivergenceError(
             f"{self.actuator.id} ({self.representation}) diverged by step {self._step_count} "
             f"(t = {self.time:.6g} s): timestep {c.timestep:.4g} s, stability limit "
             f"{c.stability_limit:.4g} s set by the highest bending mode ({c.highest_frequency:.4g} Hz) "
             f"under {c.integrator}" + ("; the reference configuration is buckled under gravity"
-                                      if c.buckled else "") + ". Reduce the timestep or the load.")
+                                      if c.buckled else "") +
+            (f"; the payload, {self.payload.mass:.4g} kg, is {self.payload.mass / beam_mass:.3g} x the beam's mass: "
+             "check its unit (SI is kg)" if heavy else "") + ". Reduce the timestep or the load.")
 
     def settle(self, tol: float = 1e-7, max_periods: int = 400) -> int:
         """Run to static equilibrium under the current loads with extra damping (first-mode

@@ -40,6 +40,19 @@ from .scene import DEFAULT_SEGMENTS, INTEGRATORS, Scene, diverged
 from ..units import DEFAULT_UNITS, UnitSystem
 
 _PREFIX = re.compile(r"^[A-Za-z][A-Za-z0-9_-]*$")
+#: what to change when a voltage is above a system's Nyquist frequency: the system's step
+#: (its actuators' twin Scenes do not set it)
+SYSTEM_TIMESTEP = "pass a smaller timestep to the System (System(spec, actuators, timestep=...))"
+
+
+def check_spec(spec) -> mujoco.MjSpec:
+    """``spec`` if it is a ``mujoco.MjSpec``; XML text, a path or anything else is refused
+    naming how to make one."""
+    if not isinstance(spec, mujoco.MjSpec):
+        shown = (spec if len(spec) <= 60 else spec[:57] + "...") if isinstance(spec, str) else type(spec).__name__
+        raise ParameterError("spec", shown, "a mujoco.MjSpec: mujoco.MjSpec.from_string(xml) for XML text, "
+                             "mujoco.MjSpec.from_file(path) for a file")
+    return spec
 
 
 _CONES = {"elliptic": mujoco.mjtCone.mjCONE_ELLIPTIC, "pyramidal": mujoco.mjtCone.mjCONE_PYRAMIDAL}
@@ -65,6 +78,29 @@ class ContactParameters:
       MuJoCo's friction is soft: under a steady tangential load f a sticking contact creeps
       at about f R / b (R its regulariser, b = 1 / h its damping); impratio > 1 cuts the
       creep by that factor (elliptic cones only).
+
+    Sizing a contact from its physics (the defaults suit a beam closing on a part, the
+    gripper's and the rod's tests; a system whose contacts carry a body may need others:
+    mjeap.robots.hamr_walk sizes the walker's feet this way). With dampratio 1 a contact's
+    penetration r obeys r'' + (2 / tau) r' + r / tau^2 = 0 (MuJoCo's reference
+    acceleration; b = 2 / (dmax tau), k = 1 / (dmax tau dampratio)^2), for any mass:
+
+    * tau well above the step: at 2 h (MuJoCo's floor) the normal and friction rows are
+      deadbeat from one step to the next and a contact that carries a body through other
+      stiff constraints can chatter; ~10 steps resolve the response.
+    * tau well below the contact's physical time scales: the critically damped response
+      settles in about 5 tau, which should be a small share of the shortest contact event
+      (a stance); a body landing at speed v penetrates at most v tau / e (critical damping),
+      to be kept within the solimp width (the penetration the model tolerates).
+    * At rest a contact carrying a force F on an effective mass m (1 / its diagonal of
+      J M^-1 J^T) penetrates about (1 - d) / d^2 x tau^2 F / m (d = dmin at a shallow depth):
+      the impedance d sets how rigid it is beside tau; and a sticking contact under a
+      tangential force f creeps at about (1 - d) / d x (f / m) x dmax tau / (2 impratio):
+      longer time constants creep more, impratio cuts it.
+    * Under 'implicitfast' MuJoCo sizes contact impulses for M alone while the step
+      integrates M + hD: a contact coupled to a damped beam (through a transmission, say)
+      is then mis-sized and can chatter however the contact is set; 'discrete' solves it in
+      the step's own metric (:func:`attach`'s ``integrator``).
     """
 
     timeconst_steps: float = 2.0
@@ -239,6 +275,7 @@ def attach(spec: mujoco.MjSpec, actuator, *, prefix: str, site: Optional[str] = 
     The host's flags are read: under ``<flag gravity="disable"/>`` the beam is sized without
     gravity; springs or dampers switched off (and actuation, for a driven beam) are refused.
     With ``contact`` the beam's own parts (its payload, neighbouring links) never touch."""
+    check_spec(spec)
     units = units or DEFAULT_UNITS
     from ..model.mjcf import get_builder
     why = get_builder(representation).attach_reason
@@ -360,6 +397,7 @@ class System:
     def __init__(self, spec: mujoco.MjSpec, actuators: Sequence[AttachedActuator], units: Optional[UnitSystem] = None,
                  timestep: Optional[float] = None, integrator: Optional[str] = None,
                  contact: Optional[ContactParameters] = ContactParameters()):
+        check_spec(spec)
         self.units = units = units or DEFAULT_UNITS
         self.actuators = list(actuators)
         prefixes = [a.prefix for a in self.actuators]
@@ -610,18 +648,23 @@ class System:
         also when the run fails or is stopped by Ctrl-C or SIGTERM: it then ends with the
         error; a second writer is refused, :func:`mjeap.outputs.guarded`). ``on_sample(system)``
         is called at every sample (e.g. to move a mocap body). ``controller(t, system)``
-        (``voltages`` then None) is called before every step and returns the voltages (V) to
-        hold over it, one per actuator or a dict by prefix (None: unchanged); each is checked
-        against its drive's safe range. It may read the system's state; a controller that
+        (``voltages`` then None; a plain function or an object, the one contract of
+        :func:`mjeap.rollout`, :func:`mjeap.engines.frame.check_controller`: its ``reset(system,
+        None)``, ``interval`` and ``name`` are used when present) is called before every step
+        (every ``interval``) and returns the voltages (V) to hold until its next call, one per
+        actuator or a dict by prefix (None: unchanged); each is checked against its drive's
+        safe range. It may read the system's state; a controller that
         senses an actuator's current steps a :meth:`drive_observer` with them. ``engine``: one
         that runs systems (:func:`mjeap.engines.choose_system`; 'auto': the loop engine).
         ``estimate_error``: each actuator's tip-curvature error from the timestep, against the
         system at half the step (:func:`mjeap.simulation.accuracy.estimate_system_error`; 2 x
         the cost; open loop without ``on_sample``), in ``meta['accuracy']``."""
-        from ..engines import choose_system
-        from ..engines.frame import Samples, check_work, sample_steps as steps_of, to_waveform, voltage_steps
+        from ..engines import choose_system, run_system_checked
+        from ..engines.frame import (Samples, check_controller, check_work, controller_every, reset_controller,
+                                     sample_steps as steps_of, to_waveform, voltage_steps)
         from ..io.outputs import write_outputs
         duration = check_positive("duration", duration, "s")
+        ctrl_name = None if controller is None else check_controller(controller)
         if estimate_error and (controller is not None or on_sample is not None):
             raise ParameterError("estimate_error", estimate_error, "False with a controller or on_sample: the "
                                  "companion run at half the step would call them again (they may keep state or "
@@ -633,8 +676,6 @@ class System:
         if controller is not None:
             if voltages is not None and any(v is not None for v in self._per_actuator("voltages", voltages)):
                 raise ParameterError("voltages", voltages, "None when a controller sets the voltages")
-            if not callable(controller):
-                raise ParameterError("controller", controller, "a callable controller(t, system) -> voltages")
             voltages = None
         waves = [None if w is None else to_waveform(w, duration) for w in self._per_actuator("voltages", voltages)]
         dt = self.timestep
@@ -648,7 +689,7 @@ class System:
                 continue
             # a waveform is checked against the drive's safe range there; the rest voltage is in it
             v_steps.append(np.full(n_steps, a.drive.rest_voltage()) if w is None else
-                           voltage_steps(w, duration, dt, a.drive))
+                           voltage_steps(w, duration, dt, a.drive, remedy=SYSTEM_TIMESTEP))
         sample_steps = steps_of(n_steps, dt, sample_interval)
         ns = len(sample_steps)
         samples = [Samples(p, ns) for p in self.parts]
@@ -661,7 +702,6 @@ class System:
                 a.drive.native_prepare(v, dt)
                 a.drive.part = p
         active = [(i, v) for i, v in zip(self.actuator_ids, v_steps) if v is not None]
-        ctrl_name = None if controller is None else getattr(controller, "name", type(controller).__name__)
         meta = {**provenance(), "actuators": {a.prefix.rstrip("/"): {"actuator": a.twin.actuator.id,
                                                      "drive": None if a.drive is None else a.drive.describe(),
                                                      "voltage": (f"controller: {ctrl_name}" if controller is not None
@@ -697,7 +737,12 @@ class System:
         wall0 = _time.perf_counter()
         def before(k):
             if controller is not None and k:
-                self._control(controller(k * dt, self), v_steps, k, ctrl_name)
+                if k % ctrl_every == 0:
+                    self._control(controller(k * dt, self), v_steps, k, ctrl_name)
+                else:                           # held between the controller's calls
+                    for vs in v_steps:
+                        if vs is not None:
+                            vs[k] = vs[k - 1]
             for i, v in active:
                 d.ctrl[i] = v[k]
             if sampled[k + 1]:
@@ -709,8 +754,10 @@ class System:
 
         try:
             if controller is not None:          # the voltage over step 0 is the first sample's
+                reset_controller(controller, self, None)
+                ctrl_every = controller_every(controller, dt)
                 self._control(controller(0.0, self), v_steps, 0, ctrl_name)
-            eng.run_system(self, n_steps, sample_steps, before, sample, check)
+            run_system_checked(eng, self, n_steps, sample_steps, before, sample, check)
             self._step_count = n_steps
         except BaseException as e:
             error = e

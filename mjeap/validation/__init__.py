@@ -7,12 +7,14 @@ with a named, independent reference (closed form, scipy solution of a model, a p
 from __future__ import annotations
 
 import time
+from contextlib import ExitStack
 from pathlib import Path
 from typing import Iterable, List, Optional
 
 from .core import REGISTRY, Check, Curve, Experiment, experiment
 from . import mechanics, dadras2021, mutlu2013, metello2020, jayaram2018  # noqa: F401  (register)
 from . import report
+from ..io.outputs import run_guard
 
 __all__ = ["REGISTRY", "Check", "Curve", "Experiment", "experiment", "run_validation", "report"]
 
@@ -44,22 +46,30 @@ def run_validation(names: Optional[Iterable[str]] = None, out: Optional[Path] = 
     except ImportError:  # pragma: no cover
         bar = names
     done: List[Experiment] = []
+    guard = ExitStack()
     if out is not None:
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
+        # the summaries locked before any work; until the last experiment has run they say
+        # which have not (an interrupted run's report is marked incomplete, never passed)
+        guard.enter_context(run_guard(json=out / "validation.json", report=out / "report.md"))
     figures = report.have_matplotlib()
-    for name in bar:
-        if hasattr(bar, "set_postfix_str"):
-            bar.set_postfix_str(name)
-        t0 = time.perf_counter()
-        ex = REGISTRY[name](quick=quick)
-        ex.seconds = time.perf_counter() - t0
-        done.append(ex)
+    with guard:
         if out is not None:
-            if figures:
-                report.write_figure(ex, out / f"{ex.name}.png")
-            png = out / f"{ex.name}.png"
-            report.write_recording(ex, out / f"{ex.name}.rrd", figure=png if figures and png.is_file() else None)
-            report.write_json(done, out / "validation.json")
-            report.write_markdown(done, out / "report.md", figures)
+            report.write_json(done, out / "validation.json", pending=names)
+            report.write_markdown(done, out / "report.md", figures, pending=names)
+        for i, name in enumerate(bar):
+            if hasattr(bar, "set_postfix_str"):
+                bar.set_postfix_str(name)
+            t0 = time.perf_counter()
+            ex = REGISTRY[name](quick=quick)
+            ex.seconds = time.perf_counter() - t0
+            done.append(ex)
+            if out is not None:
+                if figures:
+                    report.write_figure(ex, out / f"{ex.name}.png")
+                png = out / f"{ex.name}.png"
+                report.write_recording(ex, out / f"{ex.name}.rrd", figure=png if figures and png.is_file() else None)
+                report.write_json(done, out / "validation.json", pending=names[i + 1:])
+                report.write_markdown(done, out / "report.md", figures, pending=names[i + 1:])
     return done

@@ -6,7 +6,7 @@ from __future__ import annotations
 import json
 import re
 from pathlib import Path
-from typing import Optional, List
+from typing import List, Optional, Sequence
 
 import numpy as np
 
@@ -52,8 +52,11 @@ def _slug(s: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]+", "_", s).strip("_")
 
 
-def write_json(experiments: List[Experiment], path: Path) -> None:
-    doc = {"passed": all(e.passed for e in experiments),
+def write_json(experiments: List[Experiment], path: Path, pending: Sequence[str] = ()) -> None:
+    """``validation.json``: ``complete`` is false and ``passed`` false while experiments are
+    ``pending`` (not run yet, or never: an interrupted run), named in ``not_run``."""
+    doc = {"complete": not pending, "passed": not pending and all(e.passed for e in experiments),
+           "not_run": list(pending),
            "experiments": [{"name": e.name, "title": e.title, "seconds": round(e.seconds, 2), "passed": e.passed,
                             "notes": e.notes, "checks": [c.as_dict() for c in e.checks]} for e in experiments]}
     with replacing(path) as tmp:
@@ -133,8 +136,8 @@ def _write_recording(ex: Experiment, path: Path, figure: Optional[Path]) -> None
     bp = rrb.Blueprint(root, rrb.BlueprintPanel(state="collapsed"), rrb.SelectionPanel(state="collapsed"),
                        rrb.TimePanel(state="collapsed", timeline="time", play_state="paused"))
     rec = rr.RecordingStream(f"mjeap validate {ex.name}", recording_id=ex.name)
-    rec.save(str(path), default_blueprint=bp)
-    try:
+    from ..io.recording import rrd_file
+    with rrd_file(rec, path, bp):
         rec.log("checks", rr.TextDocument(markdown_section(ex, figures=False), media_type="text/markdown"), static=True)
         if have_figure:
             rec.log("figure", rr.EncodedImage(path=figure), static=True)
@@ -166,9 +169,6 @@ def _write_recording(ex: Experiment, path: Path, figure: Optional[Path]) -> None
                 continue
             rec.send_columns(ent, indexes=[rr.TimeColumn("time", duration=r.time[idx])],
                              columns=rr.LineStrips3D.columns(strips=list(pts)).partition([1] * len(idx)))
-    finally:
-        rec.flush()
-        rec.disconnect()
 
 
 def _unit_of(ex: Experiment, panel: str) -> str:
@@ -192,14 +192,19 @@ def markdown_section(ex: Experiment, figures: bool = True) -> str:
     return "\n".join(out) + "\n"
 
 
-def write_markdown(experiments: List[Experiment], path: Path, figures: bool) -> None:
+def write_markdown(experiments: List[Experiment], path: Path, figures: bool, pending: Sequence[str] = ()) -> None:
+    """``report.md``; while experiments are ``pending`` (an interrupted run) it opens by
+    saying it is incomplete and which have not run."""
     n = sum(len(e.checks) for e in experiments)
     failed = [c for e in experiments for c in e.checks if c.verdict == "FAIL"]
     toleranced = sum(c.tolerance is not None for e in experiments for c in e.checks)
     kinds = {k: sum(c.tolerance is not None and c.kind == k for e in experiments for c in e.checks)
              for k in REFERENCE_KINDS}
-    head = ["# mjeap validation report", "",
-            f"{n} rows, {toleranced} with a tolerance, {len(failed)} failed. "
+    head = ["# mjeap validation report", ""]
+    if pending:
+        head += [f"**INCOMPLETE: {len(experiments)} of {len(experiments) + len(pending)} experiments ran; not run: "
+                 f"{', '.join(pending)}.** The counts below are of those that ran.", ""]
+    head += [f"{n} rows, {toleranced} with a tolerance, {len(failed)} failed. "
             "'compare' rows set the simulation beside a published number or a model it is not "
             "expected to match within a tolerance; their notes say why they differ.", "",
             "Every toleranced row is against a reference independent of the code: "
