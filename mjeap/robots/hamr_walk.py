@@ -626,6 +626,9 @@ def walk_metrics(run: dict) -> dict:
         "body_height_range_m": [float((p @ up).min()), float((p @ up).max())],
         "max_penetration_m": float(run["penetration"].max()),
         "contact_tolerance_m": CONTACT_WIDTH_FRACTION * FOOT_RADIUS,
+        # the fastest a foot moved (m/s): a critically damped contact of time constant tau
+        # stops a body landing at v within v tau / e (contact_sizing)
+        "max_foot_speed_m_s": float(np.linalg.norm(run["feet_velocity"], axis=-1).max()),
         # stance onsets per foot per cycle: ~1 a trot, several a foot bouncing, < 1 a body in flight
         "touchdowns_per_cycle": float(((~c[:-1]) & c[1:]).sum() / 4 / (duration * f)),
         # over the whole run (a roll-over may come before the window): below 0, through the ground
