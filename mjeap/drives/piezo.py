@@ -103,7 +103,9 @@ class PiezoBimorphDrive(OpenLoop, NativeForm, Drive):
         self._v = self._dv = 0.0
         self._m = np.zeros(scene.layout.segments)
         self._rates = np.zeros(scene.layout.segments)
-        self._i_before = None                   # Gamma . (hinge rates before the last step), A
+        self._rates_before = np.zeros(scene.layout.segments)
+        self._half_bias = 0.5 * float(self.params["bias"])
+        self._i_before = None                   # whether _rates_before holds the rates before the last step
 
     @staticmethod
     def stack(actuator):
@@ -145,19 +147,23 @@ class PiezoBimorphDrive(OpenLoop, NativeForm, Drive):
         self._i_before = None
 
     def step(self, voltage: float, dt: float) -> None:
-        np.multiply(self.gamma, voltage - 0.5 * self.params["bias"], out=self._m)
-        self.part.set_internal_moments(self._m)
+        part = self.part
+        np.multiply(self.gamma, voltage - self._half_bias, out=self._m)
+        part.set_internal_moments(self._m)
         # dV/dt at the held voltage's instant t_k (module text): before the first step the
         # first voltage is taken as held
-        if self._v_prev is None:
+        v1 = self._v_prev
+        if v1 is None:
             self._dv, self._v_prev2 = 0.0, voltage
         else:
-            vpp = self._v_prev if self._v_prev2 is None else self._v_prev2
-            self._dv = (1.5 * voltage - 2.0 * self._v_prev + 0.5 * vpp) / dt
-            self._v_prev2 = self._v_prev
+            vpp = self._v_prev2
+            self._dv = (1.5 * voltage - 2.0 * v1 + 0.5 * (v1 if vpp is None else vpp)) / dt
+            self._v_prev2 = v1
         self._v = self._v_prev = voltage
-        # the rates the held voltage starts from: half of the motional current's central rate
-        self._i_before = float(np.dot(self.gamma, self.part.hinge_rates(self._rates)))
+        # the rates the held voltage starts from (internal units), half of the motional
+        # current's central rate: copied here, summed only when a current is read
+        np.copyto(self._rates_before, part.view.rates())
+        self._i_before = True
 
     def closed_loop_reason(self):
         return None
@@ -196,7 +202,8 @@ class PiezoBimorphDrive(OpenLoop, NativeForm, Drive):
         step, the rates now)."""
         vb = self.params["bias"]
         now = float(np.dot(self.gamma, self.part.hinge_rates(self._rates)))
-        i_mech = now if self._i_before is None else 0.5 * (self._i_before + now)
+        before = float(np.dot(self.gamma, self._rates_before)) / self.part.units.time
+        i_mech = now if self._i_before is None else 0.5 * (before + now)
         return ((2 * self._v - vb) / (2 * self.params["resistance"]), self.params["capacitance"] * self._dv, i_mech)
 
     def signals(self) -> Dict[str, float]:
