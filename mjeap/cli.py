@@ -3,14 +3,14 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
 import sys
 from pathlib import Path
-from typing import Callable, List, Optional
+from typing import List, Optional
 
 import numpy as np
 
-from .errors import MjeapError, ParameterError
+from .errors import ParameterError
+from .io.commandline import run_command
 
 
 def _fmt(v: float) -> str:
@@ -544,13 +544,13 @@ def build_parser() -> argparse.ArgumentParser:
                         "'auto' (threaded where it applies; default)")
     p.add_argument("--accuracy", type=float, default=None,
                    help="largest error of the tip curvature relative to its swing (1e-5 to 0.2): segments, "
-                        "integrator and timestep are chosen for it and the error is estimated (mjeap.accuracy)")
+                        "integrator and timestep are chosen for it and the error is estimated (mjeap.simulation.accuracy)")
     p.add_argument("--estimate-error", action="store_true",
                    help="without --accuracy: estimate this model's error with a coarser companion run")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_rollout)
-    p = sub.add_parser("robot",
-                       help="run a robot's experiment (mjeap.robots): gripper, hamr-leg, hamr-walk, robobee-wing",
+    from .robots import names as robot_names
+    p = sub.add_parser("robot", help=f"run a robot's experiment (mjeap.robots): {', '.join(robot_names())}",
                        description="Run a registered robot's experiment; its options follow the name "
                                    "(mjeap robot NAME --help).")
     p.add_argument("name", help="a registered robot (mjeap.robots.names())")
@@ -636,102 +636,6 @@ def build_parser() -> argparse.ArgumentParser:
                    f"of the fitted joints (default {IDENTIFIED})")
     q.set_defaults(func=cmd_identify_hinges)
     return ap
-
-
-# ---------------------------------------------------------------- running a command
-#: exit codes of an interrupted command: 128 + the signal's number, as a shell reports it
-EXIT_CTRL_C, EXIT_SIGTERM = 130, 143
-#: exit code when stdout's reader went away (128 + SIGPIPE, as a shell reports it)
-EXIT_BROKEN_PIPE = 141
-
-
-def run_command(call: Callable[[], Optional[int]], prog: str = "mjeap") -> int:
-    """Run ``call()`` as a command and return its exit code (None: 0). mjeap's own errors
-    print one line, ``PROG: error: ...``, and exit 2. Ctrl-C or SIGTERM, anywhere in the
-    command (:class:`~mjeap.errors.sigterm_as_interrupt`), print one line and exit 130 /
-    143, without a traceback; what was written stays (a rollout writes its recording and
-    CSV on its way out, a sweep has its finished rows)."""
-    from .errors import Terminated, sigterm_as_interrupt
-    try:
-        with sigterm_as_interrupt():
-            code = call()
-    except MjeapError as e:
-        print(f"{prog}: error: {e}", file=sys.stderr)
-        for note in getattr(e, "__notes__", ()):      # e.g. an output that could not be written too
-            print(f"{prog}: error: {note}", file=sys.stderr)
-        return 2
-    except KeyboardInterrupt as e:
-        term = isinstance(e, Terminated)
-        print(f"{prog}: interrupted ({'SIGTERM' if term else 'Ctrl-C'}); stopped, outputs written so far are kept",
-              file=sys.stderr)
-        for note in getattr(e, "__notes__", ()):
-            print(f"{prog}: error: {note}", file=sys.stderr)
-        return EXIT_SIGTERM if term else EXIT_CTRL_C
-    except BrokenPipeError:
-        # the reader of stdout went away (``mjeap ... | head``): the outputs are written; say
-        # so once on stderr, and point stdout at /dev/null so that Python's exit flush is quiet
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        print(f"{prog}: stdout was closed by its reader; the outputs asked for are written", file=sys.stderr)
-        return EXIT_BROKEN_PIPE
-    return 0 if code is None else int(code)
-
-
-def run_script(main: Callable[[Optional[List[str]]], Optional[int]], argv: Optional[List[str]] = None) -> int:
-    """A script's ``main(argv)`` as a command (:func:`run_command`), named after the script:
-    ``sys.exit(run_script(main))``."""
-    return run_command(lambda: main(argv), Path(sys.argv[0]).name or "mjeap")
-
-
-# ---------------------------------------------------------------- argparse checks for scripts
-def _argument_type(check: Callable[[str], object]) -> Callable[[str], object]:
-    """An argparse ``type=``: ``check(text)``, its ParameterError told the argparse way
-    (usage, ``argument --NAME: 'TEXT' is not accepted: expected ...``, exit 2), at parse
-    time, so before any work."""
-    def convert(text: str):
-        try:
-            return check(text)
-        except ParameterError as e:
-            raise argparse.ArgumentTypeError(f"{text!r} is not accepted: expected {e.accepted}"
-                                             + (f" ({e.why})" if e.why else "")) from None
-    convert.__name__ = getattr(check, "__name__", "value")
-    return convert
-
-
-def arg_integer(lo: int, hi: Optional[int] = None, why: str = ""):
-    """argparse ``type=``: an integer in [lo, hi] (:func:`mjeap.errors.check_integer`)."""
-    from .errors import check_integer
-    return _argument_type(lambda text: check_integer("", text, lo, hi, why))
-
-
-def arg_number(lo: float, hi: float, unit: str = "", lo_open: bool = False, hi_open: bool = False):
-    """argparse ``type=``: a number in the interval (:func:`mjeap.errors.check_range`)."""
-    from .errors import check_range
-    return _argument_type(lambda text: check_range("", text, lo, hi, unit, lo_open, hi_open))
-
-
-def arg_output(inside: Optional[str] = None):
-    """argparse ``type=``: an output path that can be written (its folder made now), or,
-    with ``inside``, a folder in which the file ``inside`` can be written
-    (:func:`mjeap.rollout.check_outputs`). Returns the text."""
-    from .io.outputs import check_outputs
-
-    def check(text: str) -> str:
-        check_outputs(out=Path(text) / inside if inside else text)
-        return text
-    return _argument_type(check)
-
-
-def parse_args(ap: argparse.ArgumentParser, argv: Optional[List[str]] = None,
-               check: Optional[Callable[[argparse.Namespace], None]] = None) -> argparse.Namespace:
-    """``ap.parse_args(argv)``, then ``check(args)``: checks across arguments that raise
-    ParameterError, refused as argparse refuses a bad argument (usage, one line, exit 2)."""
-    args = ap.parse_args(argv)
-    if check is not None:
-        try:
-            check(args)
-        except ParameterError as e:
-            ap.error(str(e))
-    return args
 
 
 def main(argv: Optional[List[str]] = None) -> int:

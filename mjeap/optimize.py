@@ -417,8 +417,9 @@ def optimize(actuator, vary: Mapping[str, object], maximize: Optional[str] = Non
     constraint active). Evaluations run one at a time in this process."""
     from . import design
     from .io.outputs import check_outputs, hold, replacing
-    from .sweep import METRICS, STATIC_METRICS, _check_names, _drop_torn_row, _read_sweep_csv, \
-        _RowFile, check_metric_settings, check_settings
+    from .sweep import METRICS, STATIC_METRICS, check_metric_settings, check_settings
+    from .sweep.design import _check_names
+    from .sweep.runner import _drop_torn_row, _read_sweep_csv, _RowFile
 
     t0 = time.perf_counter()
     # ---- the question, checked before any work

@@ -9,7 +9,7 @@ from pathlib import Path
 
 import numpy as np
 
-from .cli import arg_integer, arg_output, parse_args
+from .io.commandline import arg_integer, arg_output, parse_args
 from .io.outputs import replacing
 from .io.recording import rrd_file
 from .analysis.stability import MAP_BASE, column_limits, simulated_edges

@@ -24,12 +24,12 @@ error as its accuracy target.
 sweep: rollouts per second of a 16-point sweep on 1 and 2 local worker processes, and the
 memory of one rollout.
 
-native: seed 000's drive compiled into the model (mjeap.native) against the lockstep loop,
+native: seed 000's drive compiled into the model (mjeap.drives.native) against the lockstep loop,
 side by side: the heaviest experiment as one rollout, a batch of 16 on 2 threads against the
 loop one by one, mj_step of the native model against the bare beam, and the stability
 map's 30 s points per second on 2 workers with either engine.
 
-accuracy: runs at a stated accuracy (mjeap.accuracy) against the default model, side by
+accuracy: runs at a stated accuracy (mjeap.simulation.accuracy) against the default model, side by
 side: seed 000's heaviest run at 1e-2 and 1e-3 (wall, estimated and true error), a batch of
 16 at 1e-2 on 2 threads against the loop one by one, the stability map's points at 1e-2,
 where the native step's time goes (MuJoCo's timers) and the accuracy claim on seeded cases.
@@ -134,6 +134,8 @@ def bench_drives(n=20000):
     from mjeap.drives import DRIVES, make_drive
     rows = []
     for name, cls in DRIVES.items():
+        if not cls.actuators:           # a drive no catalog actuator uses ('none'): nothing to time
+            continue
         s = Scene(cls.actuators[0])
         drv = make_drive(name, s)
         drv.reset(0.0)
@@ -214,7 +216,7 @@ def _mjeap_cantilever(b, T, P, segments, drive=None, repeats=3, engine="loop"):
 
 def _mjeap_at_accuracy(T, P, target, ref, repeats=3):
     """The same cantilever with seed 000's drive running, mjeap choosing its model for
-    ``target`` (mjeap.accuracy, its quantity sampled at the end only: the settled tip arc's
+    ``target`` (mjeap.simulation.accuracy, its quantity sampled at the end only: the settled tip arc's
     curvature against a converged model, relative to its change). The chosen model is then
     built once (as the rod is) and its run timed as the others; its tip is checked against
     the elastica ``ref`` without the drive (an independent reference) and, with the drive,
@@ -330,7 +332,7 @@ def bench_elastica(T=0.05, elements=20, with_pyelastica=True):
     out["mjeap_with_drive_callback"][0]["drive"] = "blocking-force at 0 V (no moment): the callback's cost alone"
     out["mjeap_with_drive_callback"][1]["drive"] = ("rc-relaxation at 0 V: seed 000's drive; its back-relaxation "
                                                     "creeps the beam, so the tip is not the elastic one")
-    out["mjeap_with_native_drive"]["drive"] = ("rc-relaxation compiled into the model (mjeap.native, Maxwell arms), "
+    out["mjeap_with_native_drive"]["drive"] = ("rc-relaxation compiled into the model (mjeap.drives.native, Maxwell arms), "
                                                "on mujoco.rollout")
     if not with_pyelastica:
         return out
@@ -460,7 +462,7 @@ def _step_phases(model, data, n=20000) -> dict:
 
 
 def bench_accuracy(claim_cases=12):
-    """Runs at a stated accuracy (mjeap.accuracy) against today's default model, side by side:
+    """Runs at a stated accuracy (mjeap.simulation.accuracy) against today's default model, side by side:
     seed 000's heaviest run (wall of all runs, estimated and true error against 40 segments
     at 1/60 of the 10 ms sample grid under discrete), a batch of 16 at 1e-2 on 2 threads
     against the loop one by one, the stability map's points at 1e-2, where the native
@@ -604,7 +606,7 @@ BENCHMARKS = ("models", "rollout", "drives", "threaded", "elastica", "sweep", "n
 
 
 def main(argv=None):
-    from mjeap.cli import arg_number, arg_output, parse_args
+    from mjeap.io.commandline import arg_number, arg_output, parse_args
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--json", type=arg_output(), help="also write the results to this file")
     ap.add_argument("--min-seconds", type=arg_number(0.0, float("inf"), "s", True, True), default=0.5,
@@ -655,5 +657,5 @@ def main(argv=None):
 
 
 if __name__ == "__main__":
-    from mjeap.cli import run_script
+    from mjeap.io.commandline import run_script
     sys.exit(run_script(main))

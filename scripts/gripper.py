@@ -7,7 +7,7 @@ The experiment lives in :mod:`mjeap.robots.gripper`; this is its command line, t
 """
 import sys
 
-from mjeap.cli import run_script
+from mjeap.io.commandline import run_script
 from mjeap.robots.gripper import main
 
 if __name__ == "__main__":

@@ -7,7 +7,7 @@ The experiment lives in :mod:`mjeap.robots.hamr_leg`; this is its command line, 
 """
 import sys
 
-from mjeap.cli import run_script
+from mjeap.io.commandline import run_script
 from mjeap.robots.hamr_leg import main
 
 if __name__ == "__main__":

@@ -8,7 +8,7 @@ The experiment lives in :mod:`mjeap.robots.hamr_walk`; this is its command line,
 """
 import sys
 
-from mjeap.cli import run_script
+from mjeap.io.commandline import run_script
 from mjeap.robots.hamr_walk import main
 
 if __name__ == "__main__":

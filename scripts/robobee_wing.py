@@ -7,7 +7,7 @@ The experiment lives in :mod:`mjeap.robots.robobee_wing`; this is its command li
 """
 import sys
 
-from mjeap.cli import run_script
+from mjeap.io.commandline import run_script
 from mjeap.robots.robobee_wing import main
 
 if __name__ == "__main__":

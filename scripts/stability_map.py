@@ -12,7 +12,7 @@ stiffness, x 0.3/0.52), and the paper's own Region 3 model's marginal mass.
 """
 import sys
 
-from mjeap.cli import run_script
+from mjeap.io.commandline import run_script
 from mjeap.stability_map import main
 
 if __name__ == "__main__":

@@ -4,11 +4,36 @@ os.environ.setdefault("MUJOCO_GL", "disable")
 
 import pytest  # noqa: E402
 
+#: the tests grouped by layer of the package (docs/testing.md), bottom up; each test gets the
+#: marker ``layer_<name>`` of its file (``python -m pytest -m layer_drives``). The layers of
+#: the package are tests/test_layers.py's; ``contracts`` holds the failure-behaviour classes that
+#: cut across them. tests/test_docs.py checks that every test file is here and in the docs' table.
+LAYER_FILES = {
+    "foundation": ("test_layers", "test_errors", "test_units", "test_versions", "test_docs"),
+    "io": ("test_output_paths", "test_output_safety", "test_recordings"),
+    "model": ("test_section", "test_analytical", "test_lti", "test_statics", "test_dynamics", "test_axial",
+              "test_rod", "test_assets", "test_actuator_files"),
+    "drives": ("test_drive_ionic", "test_drive_electrostatic", "test_drive_allocation", "test_piezo_moment",
+               "test_piezo_power", "test_pvdf_fidelity"),
+    "engines": ("test_threaded", "test_native"),
+    "simulation": ("test_rollout", "test_system", "test_accuracy", "test_periodic", "test_golden"),
+    "analysis": ("test_identify", "test_self_sensing", "test_stability_map"),
+    "applications": ("test_sweep", "test_design_sweeps", "test_optimize", "test_actuator_cli", "test_validation",
+                     "test_controllers", "test_hamr_leg", "test_environment", "test_gymnasium_env"),
+    "robots": ("test_robots", "test_gripper", "test_hamr_leg_linkage", "test_robobee_wing", "test_hamr_walk",
+               "test_hamr_walk_rest", "test_hamr_walk_loops", "test_hamr_walk_study"),
+    "contracts": ("test_contracts", "test_early_errors", "test_silent_answers", "test_reliability", "test_registries"),
+}
+#: test file (stem) -> its layer
+LAYERS = {f: layer for layer, files in LAYER_FILES.items() for f in files}
+
 
 def pytest_configure(config):
     config.addinivalue_line("markers", "cable: needs the cable representation (MuJoCo 3.x)")
     config.addinivalue_line("markers", "rod: needs the rod representation (MuJoCo 4.x)")
     config.addinivalue_line("markers", "dm_control: needs dm_control's Physics (MuJoCo 3.x with dm-control 1.0.50)")
+    for layer in LAYER_FILES:
+        config.addinivalue_line("markers", f"layer_{layer}: a test of the {layer} layer (tests/conftest.py LAYER_FILES)")
 
 
 def pytest_collection_modifyitems(config, items):
@@ -30,6 +55,9 @@ def pytest_collection_modifyitems(config, items):
         return [x]
 
     for item in items:
+        layer = LAYERS.get(item.path.stem)
+        if layer:
+            item.add_marker(f"layer_{layer}")
         params = getattr(getattr(item, "callspec", None), "params", {})
         if not cable_available() and ("cable" in item.keywords or any(isinstance(v, str) and v == "cable" for v in values(params))):
             item.add_marker(no_cable)

@@ -1,4 +1,4 @@
-"""Runs at a stated accuracy (mjeap.accuracy): refusals, what a result carries, and the
+"""Runs at a stated accuracy (mjeap.simulation.accuracy): refusals, what a result carries, and the
 claim itself against converged runs on cases drawn by a seeded generator."""
 import json
 import math
@@ -63,6 +63,7 @@ def test_a_chosen_discrete_step_may_exceed_the_fixed_rules_a_user_step_may_not()
     assert np.all(v.model.jnt_stiffness >= 0) and np.all(v.model.dof_damping >= 0)
 
 
+@pytest.mark.slow
 def test_no_target_keeps_the_model_and_can_estimate_its_error():
     s = Scene("pedot-micro", **FAST)
     plain = rollout(s, "sine:1V@5Hz", 0.2)
@@ -119,6 +120,7 @@ def test_cli_refuses_a_timestep_beside_a_target(capsys):
     assert "--timestep" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_the_accuracy_claim_on_seeded_cases():
     """True error (against 2 x the segments at 1/4 of the step) below the target in at
     least 95 % of cases (here: all), never above 2 x; the estimate within 3 x of it in at
@@ -153,6 +155,7 @@ def test_the_spatial_error_is_richardson_of_order_2():
         assert e == pytest.approx(np.max(np.abs(c)) / N**2 / np.ptp(exact + c / N**2), rel=1e-12)
 
 
+@pytest.mark.slow
 def test_a_given_error_model_replaces_the_pilots_and_the_error_is_still_measured():
     """A prior (a, b) from elsewhere only chooses the first model: the run has no pilots, the
     segments' error is measured on the question (a spatial companion). Priors 4 x off the
@@ -203,6 +206,7 @@ def test_an_error_model_without_a_target_is_refused():
         rollout(Scene("pedot-micro", **FAST), "step:1V", 0.01, error_model=(0.1, 1.0))
 
 
+@pytest.mark.slow
 def test_the_claim_with_shared_priors_on_seeded_cases():
     """The first 6 of the seeded claim's cases (seed 23), each also run from priors 4 x off
     its own pilots' constants either way, (4 a, b / 4) and (a / 4, 4 b), as a sweep's family

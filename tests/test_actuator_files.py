@@ -176,6 +176,7 @@ gain = "made up for the test"
 """
 
 
+@pytest.mark.slow
 def test_trilayer_with_rc_relaxation_settles_at_eq_8s_dc_gain_and_bends_by_its_stack(tmp_path):
     """The step's final curvature is eq. (8)'s DC gain k z / (p_m p_e) x V (seed 000; the
     drive's moment is the one that gives it on the file's own EI), and a tip force bends

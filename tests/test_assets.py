@@ -66,7 +66,8 @@ def test_asset_compiles_and_stays_at_rest_for_1s(actuator_id, representation):
     assert abs(dx[2]) <= 2 * sag + 1e-12 * L
 
 
-@pytest.mark.parametrize("representation,segments", [("hinge", 20), ("cable", 20), ("hinge", 150), ("cable", 60)])
+@pytest.mark.parametrize("representation,segments", [("hinge", 20), ("cable", 20), pytest.param("hinge", 150, marks=pytest.mark.slow),
+                                                     pytest.param("cable", 60, marks=pytest.mark.slow)])
 def test_arena_is_sized_to_the_beam(representation, segments):
     """The MjData arena is sized from the dofs (no contacts: the finite-difference
     linearisation is the largest need), not MuJoCo's ~14 MiB default: a 20-hinge scene

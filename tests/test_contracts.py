@@ -173,6 +173,7 @@ def test_attach_refuses_xml_text_naming_how_to_make_a_spec():
 
 
 @pytest.mark.skipif(not hasattr(os, "mkfifo"), reason="FIFOs are POSIX")
+@pytest.mark.slow
 def test_load_mjcf_refuses_an_include_that_is_a_fifo(tmp_path):
     """An <include> naming a FIFO hung inside MuJoCo's reader; it is refused naming the
     include and what it is (run in a subprocess: the old code never returned)."""
@@ -190,7 +191,7 @@ def test_load_mjcf_refuses_an_include_that_is_a_fifo(tmp_path):
 
 # ---------------------------------------------------------------- the Gymnasium environment
 def _gym():
-    return pytest.importorskip("mjeap.gymnasium_env")
+    return pytest.importorskip("mjeap.envs.gymnasium_env")
 
 
 @pytest.mark.filterwarnings("ignore:MuJoCo:RuntimeWarning")

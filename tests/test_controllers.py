@@ -1,4 +1,4 @@
-"""controllers/: closed-loop rollouts through the public API (issue 5, first part)."""
+"""mjeap.controllers: closed-loop rollouts through the public API (issue 5, first part)."""
 import numpy as np
 import pytest
 
@@ -19,6 +19,7 @@ def track(mass, **kw):
     return float(np.sqrt(np.mean((r.tip_curvature[late] - ref(r.time[late])) ** 2))) / AMP, r
 
 
+@pytest.mark.slow
 def test_tracks_050_hz_sine_with_12_6_mg_inverted_within_5_percent():
     """Seed 000's heaviest payload standing up, 50 1/m at 0.05 Hz: RMS error of the second
     period below 5 % of the amplitude with feedforward + PI, within the +-1.5 V safe range;
@@ -32,6 +33,7 @@ def test_tracks_050_hz_sine_with_12_6_mg_inverted_within_5_percent():
 
 
 @pytest.mark.parametrize("mass", [0.0, 3.15e-6, 40e-6, 70e-6])
+@pytest.mark.slow
 def test_same_controller_stable_below_the_static_stability_limit(mass):
     """Every payload below the relaxed column load (76 mg, mjeap validate's
     dadras2021-stability): finite, and the tracking error stays below 10 % of the amplitude."""
@@ -39,6 +41,7 @@ def test_same_controller_stable_below_the_static_stability_limit(mass):
     assert np.all(np.isfinite(r.tip_curvature)) and e < 0.10
 
 
+@pytest.mark.slow
 def test_unreachable_reference_saturates_with_a_warning(tmp_path):
     """A reference of 400 1/m is beyond the catalog's safe range (+-3 V): the command is clipped
     to it and the recording carries a warning, the run goes on."""

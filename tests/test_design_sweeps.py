@@ -105,7 +105,7 @@ def test_a_bad_design_value_is_refused_naming_the_parameter_and_range(bimorph, p
 
 
 def test_a_sweep_refuses_bad_design_values_before_any_point_runs(bimorph, tmp_path, monkeypatch):
-    monkeypatch.setattr(sweep, "evaluate", lambda *a, **k: pytest.fail("a point ran"))
+    monkeypatch.setattr(sweep.runner, "evaluate", lambda *a, **k: pytest.fail("a point ran"))
     with pytest.raises(ParameterError, match=r"actuator.length=-0.004"):
         sweep.run_sweep(sweep.grid(**{"actuator.length": [8e-3, -4e-3]}), tmp_path / "s.csv",
                         metrics=("mass",), base={"actuator": bimorph}, executor="serial", progress=False)
@@ -121,7 +121,7 @@ def test_a_sweep_refuses_bad_design_values_before_any_point_runs(bimorph, tmp_pa
 
 # ---------------------------------------------------------------- the metrics against references
 def test_static_metrics_run_no_rollout_and_match_beta_1_with_a_tip_mass(bimorph, monkeypatch):
-    monkeypatch.setattr(sweep, "_run_point", lambda *a, **k: pytest.fail("a rollout ran"))
+    monkeypatch.setattr(sweep.runner, "_run_point", lambda *a, **k: pytest.fail("a rollout ran"))
     D = _stiffness_per_width()
     EI, mu = D * W, W * (2 * RHO_P * T_P + RHO_CF * T_CF)
     for L, m in ((0.010, 0.0), (0.010, 5e-6), (0.014, 20e-6)):
@@ -223,6 +223,7 @@ def test_cli_sweep_takes_design_parameters_with_units(bimorph, tmp_path, capsys)
     assert "did you mean 'actuator.length'" in capsys.readouterr().err
 
 
+@pytest.mark.slow
 def test_dask_runs_design_points_as_the_local_processes_do(bimorph, tmp_path):
     pytest.importorskip("distributed")
     points = sweep.grid(**{"actuator.length": [8e-3, 12e-3]})
@@ -237,10 +238,10 @@ def test_dask_runs_design_points_as_the_local_processes_do(bimorph, tmp_path):
 
 
 def test_a_registered_scene_metric_runs_no_rollout(bimorph, monkeypatch):
-    monkeypatch.setattr(sweep, "METRICS", dict(sweep.METRICS))
-    monkeypatch.setattr(sweep, "STATIC_METRICS", set(sweep.STATIC_METRICS))
+    monkeypatch.setattr(sweep.metrics, "METRICS", dict(sweep.METRICS))
+    monkeypatch.setattr(sweep.metrics, "STATIC_METRICS", set(sweep.STATIC_METRICS))
     sweep.register_metric("segments_used", lambda r, p, scene: scene.layout.segments, rollout=False)
-    monkeypatch.setattr(sweep, "_run_point", lambda *a, **k: pytest.fail("a rollout ran"))
+    monkeypatch.setattr(sweep.runner, "_run_point", lambda *a, **k: pytest.fail("a rollout ran"))
     row = sweep.evaluate({"actuator.length": 9e-3}, ("segments_used", "mass"), {"actuator": bimorph, "segments": 7})
     assert row["error"] == "" and row["segments_used"] == 7
 

@@ -35,6 +35,7 @@ def _peak_growth(fn, n=300):
 @pytest.mark.parametrize("actuator,representation", [
     ("pedot-micro", "hinge"), ("pedot-micro", "cable"), ("ppy-trilayer", "hinge"),
     ("pvdf-60", "hinge"), ("pzt-hamr-small", "hinge")])
+@pytest.mark.slow
 def test_drive_step_allocates_no_array(actuator, representation):
     scene = Scene(actuator, representation=representation, segments=SEGMENTS)
     drive = make_drive(None, scene)

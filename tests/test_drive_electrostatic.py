@@ -141,6 +141,7 @@ def test_residual_tip_mass_calibration_reproduces_the_catalog(actuator):
     assert s.tip_position()[1] == pytest.approx(_published_gains(s.actuator, 100.0)[0], rel=0.05)
 
 
+@pytest.mark.slow
 def test_tip_block_frequency_reference_matches_the_frequency_equation():
     """The tapered-plate eigenproblem with a rigid tip body (used by validate) against the
     uniform beam's frequency equation with a tip mass and rotary inertia (1e-6 relative), and

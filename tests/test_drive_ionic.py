@@ -21,6 +21,7 @@ def test_step_response_follows_eq7():
 
 
 @pytest.mark.parametrize("vpp", [2.0, 3.0])
+@pytest.mark.slow
 def test_square_wave_matches_transfer_function(vpp):
     """0.1 Hz square wave from rest: peak-to-peak tip curvature over the second period
     within 2 % of scipy.signal.lsim of eq. (8); the whole trajectory within 2 % RMS."""
@@ -48,6 +49,7 @@ def payload_runs():
     return out
 
 
+@pytest.mark.slow
 def test_payloads_inverted_stay_finite_and_increase_the_swing(capsys):
     """Each Table II payload, actuator standing up, 0.1 Hz square wave of 2 and 3 Vpp from
     the table's initial curvature: finite, and a larger peak-to-peak tip curvature in the

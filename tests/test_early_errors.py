@@ -24,9 +24,9 @@ ROOT = Path(__file__).resolve().parent.parent
 
 
 #: the modules behind the scripts' command lines (the scripts themselves are thin)
-SCRIPT_MODULES = {"hamr_leg": "mjeap.robots.hamr_leg", "robobee_wing": "mjeap.robots.robobee_wing",
-                  "gripper": "mjeap.robots.gripper", "stability_map": "mjeap.stability_map",
-                  "env_episode": "mjeap.environment"}
+SCRIPT_MODULES = {"hamr_leg": "mjeap.robots.hamr_leg.experiments", "robobee_wing": "mjeap.robots.robobee_wing.experiments",
+                  "gripper": "mjeap.robots.gripper.experiments", "stability_map": "mjeap.stability_map",
+                  "env_episode": "mjeap.envs.environment"}
 
 
 def _script(name):
@@ -220,6 +220,7 @@ def _one_line(err, how):
     assert len(lines) == 1 and f"interrupted ({how})" in lines[0], err
 
 
+@pytest.mark.slow
 def test_an_interrupted_rollout_exits_130_with_one_line_and_its_outputs(tmp_path):
     rrd, csvp = tmp_path / "r.rrd", tmp_path / "r.csv"
     code, err, _ = _interrupt([sys.executable, "-m", "mjeap.cli", "rollout", "pedot-micro", "--voltage", "step:1V",
@@ -230,6 +231,7 @@ def test_an_interrupted_rollout_exits_130_with_one_line_and_its_outputs(tmp_path
     assert rrd.stat().st_size > 0 and len(csvp.read_text().splitlines()) > 2
 
 
+@pytest.mark.slow
 def test_an_interrupted_sweep_stops_its_workers_without_tracebacks(tmp_path):
     out = tmp_path / "s.csv"
     code, err, took = _interrupt([sys.executable, "-m", "mjeap.cli", "sweep", "--vary", "amplitude=0.5,0.6,0.7,0.8",
@@ -240,6 +242,7 @@ def test_an_interrupted_sweep_stops_its_workers_without_tracebacks(tmp_path):
     assert out.read_text().startswith("point_id")
 
 
+@pytest.mark.slow
 def test_a_terminated_validation_exits_143_with_one_line(tmp_path):
     """... and its report says it is incomplete and which experiments did not run (on
     eaac59e it said '0 failed' and validation.json '"passed": true')."""
@@ -254,6 +257,7 @@ def test_a_terminated_validation_exits_143_with_one_line(tmp_path):
 
 
 @pytest.mark.parametrize("script,argv", [("hamr_leg.py", []), ("gripper.py", ["--quick"])])
+@pytest.mark.slow
 def test_an_interrupted_script_exits_130_with_one_line(tmp_path, script, argv):
     code, err, took = _interrupt([sys.executable, str(ROOT / "scripts" / script), "--out", str(tmp_path / "x.rrd"),
                                   *argv], signal.SIGINT, group=True)

@@ -5,7 +5,7 @@ from absl.testing import absltest
 from dm_env import test_utils
 
 from mjeap import ParameterError, Payload, Scene, rollout
-from mjeap.environment import make_environment, run_episode
+from mjeap.envs.environment import make_environment, run_episode
 from mjeap.io.recording import read_recording
 
 pytestmark = pytest.mark.dm_control  # dm_control's Physics: MuJoCo 3.x (mjeap.versions)

@@ -8,6 +8,7 @@ import pytest
 from mjeap.robots import gripper
 
 
+@pytest.mark.slow
 def test_grip_force_follows_the_relaxing_closed_form():
     """1 V held for 3 s: from 0.2 s after contact on, the left finger's contact force is the
     closed form (cantilever closing the 50 um gap on a stop at 5 mm, back-relaxation
@@ -24,6 +25,7 @@ def test_grip_force_follows_the_relaxing_closed_form():
     assert run.penetration < 0.01 * gripper.THICKNESS
 
 
+@pytest.mark.slow
 def test_the_bead_lifts_within_10_percent_of_the_closed_form_threshold():
     """The closed form's smallest lifting voltage v (2 mu F = m g when the base starts to
     rise, 1 s after the voltage is applied): at 0.9 v the bead is dropped, at 1.1 v it rises
@@ -37,6 +39,7 @@ def test_the_bead_lifts_within_10_percent_of_the_closed_form_threshold():
     assert high.penetration < 0.01 * gripper.THICKNESS
 
 
+@pytest.mark.slow
 def test_a_hard_finger_grasp_rolls_the_bead_out():
     """Point contacts (condim 3) at 2 V, where 2 mu F is twice the bead's weight: the bead
     is not lifted (it stays on the table); while the fingers rise it turns about y (the

@@ -1,4 +1,4 @@
-"""The Gymnasium environment (mjeap.gymnasium_env): Gymnasium's own checks, seeding, vector
+"""The Gymnasium environment (mjeap.envs.gymnasium_env): Gymnasium's own checks, seeding, vector
 envs, divergence, parameter refusals, physics against eq. (8), rendering. MuJoCo 3.17 and 4.x."""
 import subprocess
 import sys
@@ -11,10 +11,10 @@ gymnasium = pytest.importorskip("gymnasium")
 
 from gymnasium.utils.env_checker import check_env  # noqa: E402
 
-import mjeap.gymnasium_env as ge  # noqa: E402
+import mjeap.envs.gymnasium_env as ge  # noqa: E402
 from mjeap import MjeapError, ParameterError, Scene, rollout  # noqa: E402
 from mjeap.drives import DRIVES, Drive  # noqa: E402
-from mjeap.gymnasium_env import ENV_ID, CurvatureTrackingEnv  # noqa: E402
+from mjeap.envs.gymnasium_env import ENV_ID, CurvatureTrackingEnv  # noqa: E402
 
 RANDOMISED = dict(payload_mass_range=(1e-6, 12.6e-6), initial_curvature_range=(-20.0, 20.0), time_limit=0.2)
 
@@ -92,7 +92,7 @@ def test_make_and_make_vec_after_import():
 def test_import_needs_no_dm_control_and_registers_once():
     """The module imports no dm_control (whose Physics fails on MuJoCo 4); a re-import does
     not register the id again (no warning). In a fresh interpreter."""
-    code = ("import importlib, sys, warnings, mjeap.gymnasium_env as ge; "
+    code = ("import importlib, sys, warnings, mjeap.envs.gymnasium_env as ge; "
             "bad = [m for m in sys.modules if m.split('.')[0] in ('dm_control', 'dm_env')]; "
             "assert not bad, bad; "
             "warnings.simplefilter('error'); importlib.reload(ge)")
@@ -165,6 +165,7 @@ def test_bad_parameters_refused_before_any_work(monkeypatch):
     assert info["voltage_V"] == 3.0 and info["saturated_steps"] == 1
 
 
+@pytest.mark.slow
 def test_held_voltage_follows_rollout_and_eq8():
     """1 V held for 20 s on the unloaded beam lying flat. Consistency: the env's trajectory
     is mjeap.rollout's on the same model (both step the drive in lockstep). Independent
@@ -198,7 +199,7 @@ def test_held_voltage_follows_rollout_and_eq8():
 def test_reward_is_the_dm_env_tasks():
     """Same Gaussian as dm_control's rewards.tolerance (the dm_env task's reward)."""
     rewards = pytest.importorskip("dm_control.utils.rewards")
-    from mjeap.tracking import tracking_reward
+    from mjeap.envs.tracking import tracking_reward
     for err in (0.0, 0.3, -2.0, 5.0, -17.0):
         ref = rewards.tolerance(err, bounds=(0.0, 0.0), margin=5.0, sigmoid="gaussian")
         assert tracking_reward(10.0 + err, 10.0, 5.0) == pytest.approx(float(ref), rel=1e-14, abs=1e-300)

@@ -2,7 +2,7 @@
 and the 40-cycle run are the script's): two actuators, a rigid leg on swing and lift
 joints, transmissions as tendon equalities, the foot's position from the 3D kinematics.
 
-References: the point-mass leg (controllers/hamr_leg.py: the actuator's own modes with the
+References: the point-mass leg (mjeap.controllers.hamr_leg: the actuator's own modes with the
 reflected leg mass at its tip) for the resonances, T x Wood's free deflection for the
 static gain, and the paper's 5 degrees within 25 cycles for the phase loops."""
 import numpy as np
@@ -22,6 +22,7 @@ def system():
 
 
 @pytest.mark.parametrize("name", ["swing", "lift"])
+@pytest.mark.slow
 def test_transmission_resonance_and_gain(system, name):
     """A 40 Vpp sine sweep around each transmission, fitted by a second-order model: the
     resonance within 1 % of the point-mass leg's (the tolerance to which that scene's own
@@ -40,6 +41,7 @@ def test_transmission_resonance_and_gain(system, name):
     assert fit["static_gain_m_per_V"] == pytest.approx(tr.ratio * per_volt, rel=0.02)
 
 
+@pytest.mark.slow
 def test_both_phase_loops_converge_within_25_cycles(system, tmp_path):
     """Open loop the foot lags its desired phase by about 90-100 degrees (swing at its
     resonance, lift above its own); closed on the self-sensed currents, both true phase

@@ -53,6 +53,7 @@ def full_trot(system):
     return hw.walk_metrics(hw.walk(system, 10.0, measure=0.3))
 
 
+@pytest.mark.slow
 def test_the_full_amplitude_trot_moves_forward_upright_without_interpenetration(full_trot):
     """Forward at more than 2 cm/s (0.093 m/s here), |roll| and |pitch| below
     UPRIGHT_DEG = 30 degrees (12 and 11 here: the body rocks on its diagonal support), the
@@ -63,6 +64,7 @@ def test_the_full_amplitude_trot_moves_forward_upright_without_interpenetration(
     assert m["max_penetration_m"] < m["contact_tolerance_m"]
 
 
+@pytest.mark.slow
 def test_the_full_amplitude_trot_is_not_a_no_slip_walk(full_trot):
     """Recorded, not hidden: at the full 0..200 V drive the feet move T x delta = 3.5 mm fore-aft
     and 3.2 mm up and down on a 10 mm leg; the body hops and rocks, most stance samples slide
@@ -71,6 +73,7 @@ def test_the_full_amplitude_trot_is_not_a_no_slip_walk(full_trot):
     assert full_trot["slip_fraction"] > 0.5
 
 
+@pytest.mark.slow
 def test_at_low_frequency_the_speed_is_the_no_slip_kinematic_estimate(system):
     """20 Hz (the transmissions quasi-static: 0.2 and 0.25 of their resonances) at 30 V
     amplitude (feet 1 mm fore-aft and up and down): the body's speed within 10 % of the no-slip

@@ -28,6 +28,7 @@ def rest():
     return hw.stand(hw.build(), duration=1.0, after=0.5)
 
 
+@pytest.mark.slow
 def test_at_rest_the_feet_carry_the_weight_at_every_step(rest):
     """The sum of the feet's normal forces equals the weight within 1 % at every step after
     0.5 s, and every foot stays down (all four at every step)."""
@@ -37,6 +38,7 @@ def test_at_rest_the_feet_carry_the_weight_at_every_step(rest):
     assert rest["steps_with_no_foot_down"] == 0 and rest["min_feet_down"] == 4
 
 
+@pytest.mark.slow
 def test_at_rest_nothing_creeps(rest):
     """Neither the body nor any foot moves along the ground faster than 1 um/s (the feet,
     under the legs' splay, 0.12 um/s measured; the body 1e-10); the body sinks slower than
@@ -46,6 +48,7 @@ def test_at_rest_nothing_creeps(rest):
     assert abs(rest["body_vertical_drift_m_s"]) < CREEP_TOL
 
 
+@pytest.mark.slow
 def test_upside_down_the_robot_lies_on_its_chassis():
     """Dropped on its back from 20 um: it lies on the chassis, the body's frame BODY_HEIGHT
     above the ground within the contact tolerance, and the ground carries the weight within
@@ -59,6 +62,7 @@ def test_upside_down_the_robot_lies_on_its_chassis():
     assert -TOL < chassis < TOL and legs > 0
 
 
+@pytest.mark.slow
 def test_a_trot_that_rolls_over_lands_on_the_chassis_not_through_the_floor():
     """The full drive at 65 Hz throws the robot over (measured: roll 180 deg); its chassis
     reaches the ground (lowest corner within the tolerance of it) and never sinks more than

@@ -1,11 +1,11 @@
-"""The cause of HAMR-VI's roll-over at 65 Hz (mjeap.robots.hamr_walk_study), by controlled
+"""The cause of HAMR-VI's roll-over at 65 Hz (mjeap.robots.hamr_walk.study), by controlled
 one-parameter comparisons against the default model at the paper's full drive (swing and
 lift 0..200 V): the lift amplitude decides it, the legs' moving mass does not."""
 import pytest
 
 from mjeap.errors import ParameterError
 from mjeap.robots import hamr_walk as hw
-from mjeap.robots import hamr_walk_study as st
+from mjeap.robots.hamr_walk import study as st
 
 SHORT = {"measure": 0.1}         # 2 ramp + 5 settling + 7 measured cycles at 65 Hz
 
@@ -15,6 +15,7 @@ def d():
     return hw.design()
 
 
+@pytest.mark.slow
 def test_at_full_drive_the_65_hz_trot_rolls_over_and_with_a_20_v_lift_it_runs_upright(d):
     """The same model and swing (100 V): the full 100 V lift (foot +-9.4 mm at 65 Hz, the
     lift transmission's gain 2.9 below its 80 Hz resonance) throws the body off its feet
@@ -25,6 +26,7 @@ def test_at_full_drive_the_65_hz_trot_rolls_over_and_with_a_20_v_lift_it_runs_up
     assert low["upright"] and low["speed_m_s"] > 0.1
 
 
+@pytest.mark.slow
 def test_the_legs_moving_mass_is_not_the_cause(d):
     """A tenth of the legs' moving mass (armature_fraction 0.9: the rest of each joint's
     design inertia as armature, the resonances kept) still rolls over at full drive."""
@@ -32,6 +34,7 @@ def test_the_legs_moving_mass_is_not_the_cause(d):
     assert not m["upright"]
 
 
+@pytest.mark.slow
 def test_the_climb_is_friction_limited(d):
     """On a 12 deg incline at 10 Hz and full drive (upright on level ground), one parameter
     changed: with the default mu 0.51 the robot slides back down (measured -0.12 m/s along
@@ -42,6 +45,7 @@ def test_the_climb_is_friction_limited(d):
     assert low["upright"] and high["upright"]
 
 
+@pytest.mark.slow
 def test_at_80_hz_the_gait_not_the_contact_makes_the_body_hop(d):
     """At 80 Hz, 20 V (the lifts at their resonance) the body flies between landings whatever
     the contact's time constant (10 steps, the walker's, and 50, five times softer): each

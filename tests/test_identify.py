@@ -1,4 +1,4 @@
-"""mjeap.identify on simulated data with known truth (with noise) and on bad data files."""
+"""mjeap.analysis.identify on simulated data with known truth (with noise) and on bad data files."""
 import json
 
 import numpy as np
@@ -41,6 +41,7 @@ def test_step_fit_with_noise_within_its_own_uncertainty_scale():
     assert fit.rms_residual == pytest.approx(0.005 * np.ptp(k), rel=0.1)
 
 
+@pytest.mark.slow
 def test_step_fit_drive_runs_and_reproduces_the_data():
     """The fitted drive in a rollout reproduces the data it was fitted to (2 % of the swing)."""
     from mjeap import rollout
@@ -53,6 +54,7 @@ def test_step_fit_drive_runs_and_reproduces_the_data():
     assert np.sqrt(np.mean((r.tip_curvature - ref) ** 2)) < 0.02 * np.ptp(ref)
 
 
+@pytest.mark.slow
 def test_hinge_fit_recovers_stiffness_and_damping_with_noise():
     """Seed 001's identification: 1 % noise, truth k = 1.3 k0, b = 10 b0; both within 2 %."""
     s = Scene("ppy-trilayer", segments=16)

@@ -1,4 +1,4 @@
-"""Drives compiled into MJCF (mjeap.native) against the lockstep loop, the reference.
+"""Drives compiled into MJCF (mjeap.drives.native) against the lockstep loop, the reference.
 
 Tolerance: 1e-3 of the tip-curvature swing (the component issue's 0.1 %). The native
 rc-relaxation drive integrates its Maxwell arms with MuJoCo's semi-implicit step where the
@@ -128,6 +128,7 @@ PLAIN_MUJOCO = textwrap.dedent('''
 ''')
 
 
+@pytest.mark.slow
 def test_plain_mujoco_moves_the_generated_file_as_eq8_says(tmp_path):
     """The generated pedot-micro file in plain MuJoCo (a subprocess that imports no mjeap):
     ctrl = 3 V for 15 s; the curvature of the arc through clamp and tip follows eq. (8)'s

@@ -81,11 +81,12 @@ def test_the_cli_finds_the_closed_form_optimum_and_reruns_from_its_cache(bimorph
     assert (again["evaluations_run"], again["evaluations_cached"]) == (0, result["evaluations"])
 
 
+@pytest.mark.slow
 def test_differential_evolution_on_the_linearised_model_alone(bimorph, monkeypatch):
     """Maximise the mass at the floor: the same L*, by the global search then SLSQP's polish,
     every evaluation a linearised model (no rollout); a second parameter, the width, leaves
     f_1 alone and raises the mass, so it goes to its bound."""
-    monkeypatch.setattr(sweep, "_run_point", lambda *a, **k: pytest.fail("a rollout ran"))
+    monkeypatch.setattr(sweep.runner, "_run_point", lambda *a, **k: pytest.fail("a rollout ran"))
     r = mjeap.optimize(bimorph, {"actuator.length": ("5mm", "15mm")}, maximize="mass",
                        subject_to=["first_frequency>=0.8kHz"], base={"segments": 10},
                        method="differential-evolution", progress=False)

@@ -50,6 +50,7 @@ def test_a_character_device_is_written_through_never_replaced(tmp_path):
 
 
 @root_only
+@pytest.mark.slow
 def test_a_full_device_is_an_output_error_and_stays_a_device(tmp_path):
     full = tmp_path / "full"
     os.mknod(full, stat.S_IFCHR | 0o666, os.makedev(1, 7))          # /dev/full: every write is ENOSPC
@@ -197,6 +198,7 @@ def _tmpfs(folder, size):
         pytest.skip("mounting a small tmpfs needs root and a kernel that lets this sandbox mount")
 
 
+@pytest.mark.slow
 def test_a_really_full_disk_keeps_the_old_outputs_and_a_sweep_its_whole_rows(tmp_path):
     disk = tmp_path / "disk"
     _tmpfs(disk, "160k")
@@ -265,6 +267,7 @@ def test_hamr_walk_refuses_one_path_for_both_recordings(tmp_path):
     assert os.listdir(tmp_path) == []
 
 
+@pytest.mark.slow
 def test_sigterm_on_a_robot_run_keeps_each_finished_study(tmp_path):
     """robobee-wing --quick: the recording holds the first voltage's study as soon as it is
     done; SIGTERM during the second keeps it (on eaac59e it was written after both)."""

@@ -54,7 +54,7 @@ s.rollout(['step:1V'], 500.0, sample_interval=0.01, rrd=RRD, on_sample=on_sample
 """,
     "episode": """
 import numpy as np
-from mjeap.environment import make_environment, run_episode
+from mjeap.envs.environment import make_environment, run_episode
 env = make_environment(time_limit=500.0, control_interval=1e-2, segments=8)
 n = [0]
 def policy(ts):
@@ -88,6 +88,7 @@ def _leftovers(folder, keep):
 
 # ---------------------------------------------------------------- 1. SIGTERM takes Ctrl-C's path
 @pytest.mark.parametrize("kind", ["system", pytest.param("episode", marks=pytest.mark.dm_control), "scene"])
+@pytest.mark.slow
 def test_sigterm_stops_every_stepping_loop_and_its_outputs_are_written(tmp_path, kind):
     rrd, csv_path = tmp_path / "r.rrd", (tmp_path / "r.csv" if kind == "scene" else None)
     p = _start(kind, rrd, csv_path)
@@ -105,10 +106,11 @@ def test_sigterm_stops_every_stepping_loop_and_its_outputs_are_written(tmp_path,
     assert _leftovers(tmp_path, {"r.rrd", "r.csv"}) == []            # no temporary or lock file
 
 
+@pytest.mark.slow
 def test_sigterm_while_the_outputs_are_written_waits_for_them(tmp_path):
     """A stop that comes while the files are written is taken once they are complete."""
     rrd, csv_path = tmp_path / "r.rrd", tmp_path / "r.csv"
-    code = ("import time\nfrom mjeap import Scene, recording, rollout\n"
+    code = ("import time\nfrom mjeap import Scene, rollout\nfrom mjeap.io import recording\n"
             "log = recording._log_outcome\n"
             "def slow(*a, **k):\n    print('ready', flush=True)\n    time.sleep(2)\n    return log(*a, **k)\n"
             "recording._log_outcome = slow\n"
@@ -127,6 +129,7 @@ def test_sigterm_while_the_outputs_are_written_waits_for_them(tmp_path):
 
 
 # ---------------------------------------------------------------- 2. one writer, whole files
+@pytest.mark.slow
 def test_a_second_writer_of_an_output_is_refused_before_any_work(tmp_path, monkeypatch):
     rrd, csv_path = tmp_path / "r.rrd", tmp_path / "r.csv"
     p = _start("scene", rrd, csv_path)
@@ -157,7 +160,7 @@ def test_a_second_writer_of_an_output_is_refused_before_any_work(tmp_path, monke
 def test_outputs_are_renamed_into_place_whole(tmp_path, monkeypatch):
     """While a run writes, its paths still hold the previous files (a reader never sees a
     part); the new files replace them whole, and nothing else is left beside them."""
-    from mjeap import recording
+    from mjeap.io import recording
     rrd, csv_path = tmp_path / "r.rrd", tmp_path / "r.csv"
     rrd.write_bytes(b"old recording")
     csv_path.write_text("old,csv\n")

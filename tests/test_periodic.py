@@ -38,6 +38,7 @@ def test_a_stopped_run_is_the_full_runs_start_and_its_rest_repeats_the_last_peri
     assert s.time == pytest.approx(t_stop, abs=s.timestep)
 
 
+@pytest.mark.slow
 def test_a_run_still_relaxing_runs_on_until_its_drift_is_within_the_tolerance():
     """From a bent start (-300 1/m) the curvature relaxes on the mechanical pole, the
     zero-input term of seed 000's eq. (7): period to period it drifts by
@@ -68,6 +69,7 @@ def test_a_run_still_relaxing_runs_on_until_its_drift_is_within_the_tolerance():
     assert "stopped_early" not in r.meta and r.time[-1] == pytest.approx(30.0, abs=0.01)
 
 
+@pytest.mark.slow
 def test_a_slow_creep_under_a_fast_drive_is_not_taken_for_periodic():
     """Relaxation at 0.3 1/s under a 5 Hz drive changes each period by little but adds up over
     many: wherever the run stops, every later period of the run continued to its end stays

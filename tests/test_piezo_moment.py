@@ -102,7 +102,7 @@ def _cycle_energy(model, data, set_input, electrical_power, settle_steps, cycle_
     return w_el, diss, float(data.energy.sum()) - e0
 
 
-@pytest.mark.parametrize("f_ratio, steps_per_period", [(1.0, None), (0.5, 10000)])
+@pytest.mark.parametrize("f_ratio, steps_per_period", [(1.0, None), pytest.param(0.5, 10000, marks=pytest.mark.slow)])
 def test_piezo_energy_balance_over_a_cycle(f_ratio, steps_per_period):
     """Native pzt-hamr-small (the default engine), sine drive: the electrical work into the
     motional branch over one period, (V_sig - V_bias/2) I_mech summed over both sources (each
@@ -144,6 +144,7 @@ def test_piezo_energy_balance_over_a_cycle(f_ratio, steps_per_period):
     assert (diss + de) / w_el == pytest.approx(1.0, abs=0.01)
 
 
+@pytest.mark.slow
 def test_seed_000_energy_balances_over_a_cycle():
     """Seed 000's model is one-way (eq. 8: the double layer does not see the beam's motion), so
     its energy closes on each side. Native pedot-micro, 1.5 V sine at 0.5 Hz, one period after

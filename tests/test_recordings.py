@@ -1,6 +1,6 @@
 """Every kind of recording opens laid out with every signal readable (issue: recordings a
 reviewer can read at a glance). Read back from the .rrd: the entities, the default
-blueprint's views (mjeap.recording.read_blueprint) and the images. What they look like was
+blueprint's views (mjeap.io.recording.read_blueprint) and the images. What they look like was
 checked by rendering them (scripts/render_recording.py) and looking at the PNGs."""
 import re
 
@@ -70,6 +70,7 @@ def test_deformation_scale_and_scale_bar_are_1_2_5_steps():
     assert scale_bar_length(6e-3) == 1e-3 and scale_bar_length(52e-3) == 1e-2
 
 
+@pytest.mark.slow
 def test_validation_recordings_show_checks_figure_and_beams(tmp_path):
     pytest.importorskip("matplotlib")
     from mjeap.validation import run_validation
@@ -110,7 +111,7 @@ def test_system_recording_has_a_group_per_actuator_and_every_body(tmp_path):
 
 @pytest.mark.dm_control
 def test_environment_episode_recording_is_laid_out(tmp_path):
-    from mjeap.environment import make_environment, run_episode
+    from mjeap.envs.environment import make_environment, run_episode
     env = make_environment("pedot-micro", time_limit=0.2, seed=0)
     run_episode(env, policy=lambda ts: [0.5], rrd=tmp_path / "ep.rrd")
     views = read_blueprint(tmp_path / "ep.rrd")

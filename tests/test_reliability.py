@@ -101,7 +101,7 @@ def test_a_payload_in_kilograms_where_milligrams_were_meant_is_warned():
 
 # ---------------------------------------------------------------- outputs (class 4)
 def test_outputs_are_checked_before_stepping_and_written_independently(tmp_path, monkeypatch, capsys):
-    from mjeap import recording
+    from mjeap.io import recording
     from mjeap.errors import DivergenceError, OutputError
     s = Scene("pedot-micro")
     blocker = tmp_path / "a-file"
@@ -282,6 +282,7 @@ def _alive(pid: int) -> bool:
 
 
 @pytest.mark.parametrize("how", ["SIGTERM", "SIGKILL"])
+@pytest.mark.slow
 def test_stopping_a_sweep_stops_its_workers_and_keeps_its_rows(tmp_path, how):
     """SIGTERM takes Ctrl-C's path (the workers are stopped, finished rows kept, no waiting
     for the 60 s points in flight); kill -9 of the sweep leaves no orphaned worker (they die
@@ -364,6 +365,7 @@ def test_csvs_are_read_as_users_save_them(tmp_path, capsys):
 
 
 # ---------------------------------------------------------------- smaller items
+@pytest.mark.slow
 def test_sigterm_ends_a_rollout_cleanly_with_its_outputs(tmp_path):
     import subprocess
     import sys
@@ -384,7 +386,7 @@ def test_sigterm_ends_a_rollout_cleanly_with_its_outputs(tmp_path):
 
 def test_mujoco_warnings_become_python_warnings_without_a_log_file(tmp_path, monkeypatch):
     import mujoco
-    import mjeap.environment  # noqa: F401  (dm_control installs a handler of its own on import)
+    import mjeap.envs.environment  # noqa: F401  (dm_control installs a handler of its own on import)
     monkeypatch.chdir(tmp_path)
     m = mujoco.MjModel.from_xml_string('<mujoco><worldbody><body><freejoint/><geom size="1"/></body></worldbody></mujoco>')
     d = mujoco.MjData(m)

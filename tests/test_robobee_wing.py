@@ -49,6 +49,7 @@ def test_transmission_reflects_the_wing_inertia_onto_the_tip():
     assert f_sim == pytest.approx(f_ref, rel=0.01)
 
 
+@pytest.mark.slow
 def test_stroke_peaks_between_30_and_270_hz_and_is_self_sensed():
     """The stroke rises to the transmission resonance and falls after it; self-sensed within
     seed 003's 10 % at 30 and 90 Hz. At 270 Hz the wing's inertia nearly blocks the

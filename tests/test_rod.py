@@ -65,6 +65,7 @@ def test_elastica_to_alpha_10_within_a_thousandth_of_L(representation, segments)
 
 
 # ---------------------------------------------------------------------------- dynamics
+@pytest.mark.slow
 def test_buckling_load_within_1_percent():
     """Standing up under a tip payload: the modal analysis (in the hinge angles, gravity's
     geometric stiffness from the vertices' lever arms) calls the column straight at 0.99 x
@@ -96,6 +97,7 @@ def test_buckling_load_within_1_percent():
         assert np.min(y) < -0.3 * y0
 
 
+@pytest.mark.slow
 def test_seed_000_heaviest_run_matches_the_hinge_chain_within_1_percent_of_the_swing():
     """Seed 000's heaviest run (pedot-micro standing up, 12.6 mg NdFeB payload at 6.27 mm,
     square 3 Vpp at 0.1 Hz for 20 s from -303 1/m, its rc-relaxation drive): the rod's tip

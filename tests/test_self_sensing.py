@@ -33,6 +33,7 @@ def capacitance(scene):
 
 
 @pytest.mark.parametrize("c_scale", [1.0, 2.0])
+@pytest.mark.slow
 def test_eq8_recovers_the_blocking_factor(scene, sweeps, c_scale):
     """With C_fit = c_scale x the free capacitance (2: the datasheet's 16 nF against the fixed
     actuator's ~8 nF, seed 003), eq. (8) must return beta = 1 / c_scale, as closely as its
@@ -53,6 +54,7 @@ def test_eq8_recovers_the_blocking_factor(scene, sweeps, c_scale):
     assert est.beta * c_scale == pytest.approx(one.beta, rel=1e-4)
 
 
+@pytest.mark.slow
 def test_velocity_scale_matches_eq_13_and_eq_17b(scene, sweeps):
     """Well below resonance the beam bends as a uniform arc: v = (L/2 + l_ext) L dkappa/dt at
     the tip block's end and eq. (13) gives I_mech = 2 A f31 (t_p + t_cf)/2 dkappa/dt (the plate's
@@ -76,6 +78,7 @@ def test_velocity_scale_matches_eq_13_and_eq_17b(scene, sweeps):
     assert r.min() <= est.alpha <= r.max()
 
 
+@pytest.mark.slow
 def test_estimate_within_the_papers_accuracy_at_every_bias(scene, sweeps):
     """Calibrated once at 60 V (beta and alpha), applied unchanged at 20, 60 and 100 V."""
     est = calibrate(sweeps[60.0], 60.0, R_FIT, 2.0 * capacitance(scene))
@@ -86,6 +89,7 @@ def test_estimate_within_the_papers_accuracy_at_every_bias(scene, sweeps):
         assert np.abs(ph).max() < PHASE_TOL, (b, ph)
 
 
+@pytest.mark.slow
 def test_without_the_blocking_factor_the_estimate_fails(scene, sweeps):
     """The same check must fail with the datasheet capacitance taken as is (beta = 1): the
     dielectric current left over, C dV/dt beside the motional C_m dV/dt (C_m / C = 1.26), is
@@ -127,6 +131,7 @@ def test_noise_on_the_current_grows_the_error_linearly(scene):
         assert err0 < 0.01
 
 
+@pytest.mark.slow
 def test_blocking_factor_does_not_depend_on_the_step():
     """Eq. 8 on the RoboBee actuator's sweep to 2 f_1, where the dielectric current is 2.8 x
     the motional and nearly opposite it, the fit most sensitive to their relative instant:

@@ -3,7 +3,7 @@ before any work, naming the parameter (or flag) and what is accepted.
 
 References: the equivalent one-actuator Scene (an attached beam moves as it does, round-off
 apart: tests/test_system.py), the first mode's damping ratio of the step map
-(mjeap.modes.first_mode_damping: the catalog's 0.05), and rollout's own bounds."""
+(mjeap.model.modes.first_mode_damping: the catalog's 0.05), and rollout's own bounds."""
 import mujoco
 import numpy as np
 import pytest
@@ -117,7 +117,7 @@ def test_passive_beam_in_a_host_without_actuation_and_gravity_changed_after_atta
 def test_environment_initial_curvatures_within_rollouts_bounds(bounds):
     """(-1e5, 1e5) 1/m started episodes 60 turns round; NaN overflowed. rollout's bounds
     (finite, at most a full circle) apply, refused when the environment is made."""
-    from mjeap.environment import make_environment
+    from mjeap.envs.environment import make_environment
     with pytest.raises(ParameterError, match=r"initial_curvature_range.*\[-1047.2, 1047.2\] 1/m"):
         make_environment(initial_curvature_range=bounds)
 
@@ -155,7 +155,7 @@ def test_read_units_reads_its_own_field_only():
 # 6 ------------------------------------------------------------------------------------------
 @pytest.mark.dm_control
 def test_policy_with_two_values_for_one_actuator_is_refused():
-    from mjeap.environment import make_environment
+    from mjeap.envs.environment import make_environment
     env = make_environment(time_limit=0.05, payload=None, orientation="horizontal")
     env.reset()
     env.step([0.5])

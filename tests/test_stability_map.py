@@ -1,4 +1,4 @@
-"""The stability map of seed 000's inverted actuator (mjeap.stability, scripts/stability_map.py).
+"""The stability map of seed 000's inverted actuator (mjeap.stability_map, mjeap.analysis.stability, scripts/stability_map.py).
 
 Physics claim: the simulated payload limit sits at the static column load with the relaxed
 EI (76 mg at l_e = 6.27 mm), not at the paper's Region 3 model (46 mg) or the instantaneous
@@ -41,6 +41,7 @@ def test_simulated_edge_sits_at_the_relaxed_column_load(tmp_path):
     assert 0.8 * relaxed < edge < 1.25 * relaxed
 
 
+@pytest.mark.slow
 def test_script_writes_report_image_and_recording(tmp_path):
     pytest.importorskip("matplotlib")
     out = tmp_path / "map"
@@ -58,6 +59,7 @@ def test_script_writes_report_image_and_recording(tmp_path):
         {("TextDocument", "/report"), ("2D", "/figure")}
 
 
+@pytest.mark.slow
 def test_script_stops_points_once_periodic_and_refuses_a_stop_its_periods_cannot_make(tmp_path):
     """--stop-when-periodic needs four periods: with the map's three it is refused before any
     point (no results file); with six, a light payload's point stops and its row says where."""

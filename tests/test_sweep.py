@@ -20,6 +20,7 @@ def test_designs():
     assert point_id({"a": 1, "b": 2}) == point_id({"b": 2, "a": 1})
 
 
+@pytest.mark.slow
 def test_peak_to_peak_metric_matches_the_drive_model():
     """Unloaded, the drive's own analytical curvature (eq. 8 under the same square wave)
     is the reference: within 1 % over the last period."""
@@ -54,6 +55,7 @@ def test_processes_and_serial_agree(tmp_path):
     assert (tmp_path / "b-rrd" / f"point-{point_id(POINTS[0], BASE, ('peak_to_peak', 'returns'))}.rrd").exists()
 
 
+@pytest.mark.slow
 def test_dask_local_cluster_agrees(tmp_path):
     pytest.importorskip("distributed")
     serial = run_sweep(POINTS[:2], tmp_path / "a.csv", base=BASE, executor="serial", progress=False)
@@ -72,14 +74,15 @@ def test_bad_sweep_input():
         run_sweep(POINTS[:1], "/tmp/never-exec.csv", base=BASE, executor="mpi", progress=False)
 
 
+@pytest.mark.slow
 def test_at_a_target_a_family_shares_its_first_points_error_model(tmp_path, monkeypatch):
     """Points differing only in load sizes (amplitude here) start from the first one's error
     model: the others are handed the (a, b) the first ran with and run no pilots (the row
     says so); another actuator is another family. Each point's estimated error is measured
     on it and meets the target, and its peak-to-peak agrees with pilots per point within
     what the two targets allow."""
-    import mjeap.sweep as sw
-    from mjeap.sweep import _family
+    import mjeap.sweep.runner as sw
+    from mjeap.sweep.runner import _family
     base = {"actuator": "pedot-micro", "orientation": "horizontal", "waveform": "sine", "frequency": 5.0,
             "duration": 0.2, "accuracy": 1e-3}
     pts = [{"amplitude": a} for a in (0.5, 1.0, 1.5)]

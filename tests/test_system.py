@@ -1,4 +1,4 @@
-"""Actuators as MuJoCo components (mjeap.system): attached to a host model written here, several
+"""Actuators as MuJoCo components (mjeap.simulation.system): attached to a host model written here, several
 in one system, with contact.
 
 References: the equivalent one-actuator Scene (the same beam, damping and timestep; round-off
@@ -71,6 +71,7 @@ TWO = ('<body name="base"><site name="a" pos="0 0 0" quat="0.7071068 0.7071068 0
        '<site name="b" pos="0 30 0" quat="0.7071068 0.7071068 0 0"/></body>')
 
 
+@pytest.mark.slow
 def test_two_actuators_not_touching_each_move_as_alone():
     """Two actuators whose bending planes are vertical (gravity bends them): one driven, one
     at 0 V (sagging and creeping under its own weight). Each equals its one-actuator run
@@ -231,7 +232,7 @@ def test_transmission_inputs_are_named():
         add_transmission(spec, a, "nope", 4000.0)
 
 
-@pytest.mark.parametrize("wave,duration", [("square:1V@2Hz", 0.5), ("sine:1V@20Hz", 0.2)])
+@pytest.mark.parametrize("wave,duration", [pytest.param("square:1V@2Hz", 0.5, marks=pytest.mark.slow), ("sine:1V@20Hz", 0.2)])
 def test_a_system_estimates_its_step_error(wave, duration):
     """estimate_error: each actuator's tip-curvature error from the timestep, against the
     system at h / 2 (order 1.5 assumed). Reference: the same system at h / 16 (its own step

@@ -48,7 +48,7 @@ def test_threaded_equals_loop(actuator, representation, voltage, duration, param
 
 @pytest.mark.cable
 def test_auto_picks_threaded_only_where_it_applies():
-    """auto: the drive compiled into the model where it has a native form (mjeap.native),
+    """auto: the drive compiled into the model where it has a native form (mjeap.drives.native),
     else threaded where it is open-loop, else the loop."""
     assert rollout(Scene("pzt-hamr-small"), "step:120V", 1e-3).meta["engine"] == "native"
     assert rollout(Scene("pzt-hamr-small", representation="cable"), "step:120V", 2e-4).meta["engine"] == "threaded"

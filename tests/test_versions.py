@@ -41,7 +41,7 @@ def test_rod_on_mujoco_3_is_refused_naming_the_reason():
 
 @on_4
 def test_dm_env_on_mujoco_4_is_refused_naming_the_versions():
-    from mjeap.environment import make_environment
+    from mjeap.envs.environment import make_environment
     with pytest.raises(MjeapError, match=r"dm-control .*MuJoCo 4.*mujoco>=3.17,<4"):
         make_environment(time_limit=0.05)
     assert "flex_vertedge" in dm_control_problem()

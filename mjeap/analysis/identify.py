@@ -6,7 +6,7 @@
   decays on the mechanical pole. Returns the transfer function and a drive that runs it.
 * :func:`fit_hinge_parameters` (seed 001): joint stiffness and damping of the hinge chain
   fitted to a measured tip trajectory by nonlinear least squares (scipy.optimize), the chain
-  itself (a :class:`~mjeap.scene.Scene`) being the model.
+  itself (a :class:`~mjeap.simulation.scene.Scene`) being the model.
 * :func:`read_columns`: a user's CSV, checked (columns present, time increasing, finite,
   enough samples) with errors that say what is wrong.
 * :func:`step_actuator`, :func:`hinge_actuator`: an actuator (a user's file) with what was

@@ -333,7 +333,7 @@ class OpenLoop:
 
 class NativeForm:
     """A drive that can be compiled into the model as MuJoCo elements (the native engine's
-    and :class:`mjeap.System`'s need, :mod:`mjeap.native`): :meth:`add_native` and the
+    and :class:`mjeap.System`'s need, :mod:`mjeap.drives.native`): :meth:`add_native` and the
     read-outs of its state from a native run. The defaults replay the loop drive, for a
     drive that is also :class:`OpenLoop`. Mixed in before :class:`Drive`."""
 
@@ -343,7 +343,7 @@ class NativeForm:
     def add_native(self, spec, joints, parent: str):
         """Add the drive to ``spec`` (the scene's, internal units) as MuJoCo elements acting
         on the hinge ``joints``; relaxation bodies go under body ``parent``. Returns the
-        :class:`mjeap.native.NativeHandles`."""
+        :class:`mjeap.drives.native.NativeHandles`."""
         raise NotImplementedError(self.native_reason())
 
     def native_reset(self, part, handles, prefix: str = "") -> None:

@@ -14,7 +14,7 @@ Moment per volt, derived three ways (they agree; the factor was 1/2 before issue
 
    Harvard's HAMR actuator model (PZTBender2.m) writes the same as forces Ft - Fb that are
    proportional to the plates' voltage difference V = 2 V_sig - V_bias, which is the V of
-   the closed forms in ``mjeap.analytical`` (V_bias at full drive).
+   the closed forms in ``mjeap.model.analytical`` (V_bias at full drive).
 2. Seed 003 eq. (13): I_mech = 2 A f31 d(eps_1)/dt, eps_1 the bending strain of one plate,
    kappa (t_p + t_cf) / 2 at its mid-plane. Over a hinge j of width w_j and rotation theta_j
    (A eps_1 summed as w_j l_j kappa_j (t_p + t_cf)/2 = w_j theta_j (t_p + t_cf) / 2):
@@ -212,7 +212,7 @@ class PiezoBimorphDrive(OpenLoop, NativeForm, Drive):
                 "current_capacitive (A)": i_c, "current_motional (A)": i_m,
                 "drive_moment_root (N m)": float(self._m[0])}
 
-    # ---- Wood / Jafferis closed forms (mjeap.analytical), at this drive's V_eff -------------
+    # ---- Wood / Jafferis closed forms (mjeap.model.analytical), at this drive's V_eff -------------
     def bending_stiffness_per_width(self) -> float:
         sec = self.scene.actuator.section_at(0.0)
         return sec.flexural_rigidity / float(self.scene.actuator.width_at(0.0))

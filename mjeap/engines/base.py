@@ -25,7 +25,7 @@ class Engine:
         return None
 
     def part(self, scene, drive):
-        """The actuator part (:class:`mjeap.component.ActuatorPart`) whose state the samples
+        """The actuator part (:class:`mjeap.simulation.part.ActuatorPart`) whose state the samples
         read: the scene's own unless the engine steps another model."""
         return scene.part
 

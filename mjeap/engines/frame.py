@@ -65,7 +65,7 @@ class RolloutResult:
 
     def to_csv(self, path: Union[str, Path]) -> None:
         """Time series (no centreline) as CSV with SI units in the header, written whole
-        (:func:`mjeap.outputs.replacing`) and spreadsheet-safe (:class:`mjeap.csvio.writer`)."""
+        (:func:`mjeap.io.outputs.replacing`) and spreadsheet-safe (:class:`mjeap.io.csvio.writer`)."""
         cols = {"time (s)": self.time, "voltage (V)": self.voltage,
                 "tip_x (m)": self.tip_position[:, 0], "tip_y (m)": self.tip_position[:, 1],
                 "tip_z (m)": self.tip_position[:, 2], "tip_angle (rad)": self.tip_angle,
@@ -80,7 +80,7 @@ class RolloutResult:
 
 class Samples:
     """Preallocated sample arrays of one rollout of one actuator (an
-    :class:`~mjeap.component.ActuatorPart`). A sample copies MuJoCo's raw world positions
+    :class:`~mjeap.simulation.part.ActuatorPart`). A sample copies MuJoCo's raw world positions
     (clamp, links, payload, tip site), the tip's orientation (and the clamp's, where the
     clamp can move) and the drive's signals; the clamp-frame SI read-outs (the part's
     clamp_frame and in_plane_angle, as its own read-outs use) are computed for all samples
@@ -239,7 +239,7 @@ def one_voltage(value, name: str, where: str = "") -> float:
     number or a one-element array (shape (1,), a dm_env action). Text, None, a bool, more
     values (two for one actuator, never cut to the first), none or NaN/inf are refused
     naming ``name``, the shape expected and ``where`` (the controller and time). The one
-    check of every command path (:func:`rollout`'s loop, :class:`mjeap.system.System`,
+    check of every command path (:func:`rollout`'s loop, :class:`mjeap.simulation.system.System`,
     the dm_env environment)."""
     try:
         a = None if isinstance(value, (str, bytes, bool, type(None))) else np.asarray(value)

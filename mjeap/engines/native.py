@@ -1,4 +1,4 @@
-"""The ``native`` engine: the drive compiled into the model (:class:`mjeap.native_model.NativeModel`),
+"""The ``native`` engine: the drive compiled into the model (:class:`mjeap.simulation.native_model.NativeModel`),
 the voltages its actuator's ctrl, stepped by ``mujoco.rollout`` (no Python per step; many
 rollouts over a thread pool)."""
 from __future__ import annotations
@@ -45,7 +45,7 @@ class NativeEngine(Engine):
 
 def run_native(scene, native, drives: Sequence, v_steps: Sequence[np.ndarray], initial_curvatures: Sequence[float],
                sample_steps: np.ndarray, samples: Sequence, nthread: int = 0) -> None:
-    """As :func:`run`, on the scene's native model (:class:`mjeap.native_model.NativeModel`): the
+    """As :func:`run`, on the scene's native model (:class:`mjeap.simulation.native_model.NativeModel`): the
     controls are the voltages themselves (the actuator's ctrl), the drive runs inside
     MuJoCo. The scene is left in the final state of the last run (its beam dofs)."""
     m, d, part, h = native.model, native.data, native.part, native.handles

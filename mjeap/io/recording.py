@@ -213,7 +213,7 @@ def rrd_file(rec, path, blueprint=None):
 
 def write_recording(path, result, scene, extra=None, views=(), deformation: float = None) -> Path:
     """Write ``result`` of a rollout of ``scene`` to ``path`` (.rrd); the file is flushed,
-    closed and renamed into place whole (:func:`mjeap.outputs.replacing`) before returning,
+    closed and renamed into place whole (:func:`mjeap.io.outputs.replacing`) before returning,
     also for a failed (partial) run. ``extra(rec)`` may log
     more entities to the open ``rerun.RecordingStream``; ``views`` (rerun blueprint views)
     are added to the default layout for them. ``deformation``: displayed deformation scale
@@ -345,7 +345,7 @@ def _geom_archetype(rr, model, g: int, length: float, color):
 
 
 def write_system_recording(path, result, system, extra=None, views=(), actuator_views: bool = True) -> Path:
-    """Write a :class:`mjeap.system.SystemResult` to ``path`` (.rrd): every beam's
+    """Write a :class:`mjeap.simulation.system.SystemResult` to ``path`` (.rrd): every beam's
     centreline and tip (world frame, m), every other body's geoms (boxes, spheres,
     ellipsoids, capsules, cylinders) moving with their bodies, and per actuator its voltage
     and tip curvature; the net contact force on every body that touches something.
@@ -353,7 +353,7 @@ def write_system_recording(path, result, system, extra=None, views=(), actuator_
     (rerun blueprint views) are placed first in the plots' column for them.
     ``actuator_views=False`` logs each actuator's plots but leaves their views out of the
     layout (a system of many actuators: the column keeps ``views`` readable). Written whole
-    (:func:`mjeap.outputs.replacing`)."""
+    (:func:`mjeap.io.outputs.replacing`)."""
     with replacing(path, "rrd") as tmp:
         _write_system_recording(tmp, result, system, extra, views, actuator_views)
     return Path(path)

@@ -52,7 +52,7 @@ class Planform:
     extension_mass: float = 0.0
     extension_source: str = "none"
     #: labelled residual: mass (kg) added to the tip block at fixed length, calibrated to a
-    #: measured resonance (mjeap.calibration.calibrate_tip_mass); 0 = none
+    #: measured resonance (mjeap.analysis.calibration.calibrate_tip_mass); 0 = none
     residual_tip_mass: float = 0.0
     residual_source: str = "none"
 

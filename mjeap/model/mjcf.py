@@ -68,16 +68,16 @@ class BeamBuilder:
     #: the integrators it runs under, and the one a Scene takes when none is named
     integrators: Tuple[str, ...] = ("implicitfast", "discrete")
     default_integrator: str = "implicitfast"
-    #: per-dof damping travels in the custom numeric mjeap_dof_damping (mjeap.scene), applied
+    #: per-dof damping travels in the custom numeric mjeap_dof_damping (mjeap.simulation.scene), applied
     #: after compiling: MJCF has one damping per joint (the cable's ball joints)
     stores_dof_damping: bool = False
     #: the stability limit is also checked bent (Scene's max_bend): stiffness that couples
     #: once bent (the cable)
     check_bent_stability: bool = False
-    #: per-hinge stiffness and damping can be set (mjeap.identify)
+    #: per-hinge stiffness and damping can be set (mjeap.analysis.identify)
     per_hinge_parameters: bool = False
-    #: why a native drive (mjeap.native), the threaded engine, a run at an accuracy target,
-    #: attaching to a host (mjeap.system) do not apply (None: they do)
+    #: why a native drive (mjeap.drives.native), the threaded engine, a run at an accuracy target,
+    #: attaching to a host (mjeap.simulation.system) do not apply (None: they do)
     native_reason: Optional[str] = None
     threaded_reason: Optional[str] = None
     accuracy_reason: Optional[str] = None
@@ -130,7 +130,7 @@ class BeamBuilder:
 
     def linearize(self, model: mujoco.MjModel, handles: BeamHandles, layout: BeamLayout, units: UnitSystem,
                   angles: Optional[np.ndarray] = None):
-        """Mass and stiffness matrices (:class:`mjeap.modes.Linearization`) in the beam's own
+        """Mass and stiffness matrices (:class:`mjeap.model.modes.Linearization`) in the beam's own
         coordinates, at its reference configuration or bent by ``angles`` (rad per hinge)."""
         from .modes import linearize
         if angles is None:

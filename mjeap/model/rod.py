@@ -86,7 +86,7 @@ Refused on the rod, each with its reason (:class:`RodBuilder`):
   then refuses the box-section rod ("1D flex elasticity with box section requires per-edge
   twist joints", measured). Attaching the twist bodies to the host's world as well might
   make it compile; not built.
-* accuracy targets (:mod:`mjeap.accuracy`): its error model is the hinge chain's.
+* accuracy targets (:mod:`mjeap.simulation.accuracy`): its error model is the hinge chain's.
 """
 from __future__ import annotations
 

@@ -45,7 +45,7 @@ def write_hinge_angles(qpos: np.ndarray, qposadr: np.ndarray, angles, hinge: boo
 
 class BeamView:
     """How one beam representation reads and drives its bending in a compiled model
-    (internal units): made by its builder (:meth:`mjeap.mjcf.BeamBuilder.view`) for an
+    (internal units): made by its builder (:meth:`mjeap.model.mjcf.BeamBuilder.view`) for an
     :class:`ActuatorPart`, which holds the SI side. ``bend_dof``: the generalised dof that
     carries each hinge's bending (None where no dof does, e.g. the rod's vertices)."""
 

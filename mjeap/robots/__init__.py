@@ -1,5 +1,5 @@
 """Robots built from mjeap's actuators, in the style of dm_control's suite: a registry of
-named robots, each with its builder (returns a :class:`~mjeap.system.System`), its named
+named robots, each with its builder (returns a :class:`~mjeap.System`), its named
 read-outs (SI) and its experiment's command line, tagged by what it shows.
 
     from mjeap import robots
@@ -8,8 +8,12 @@ read-outs (SI) and its experiment's command line, tagged by what it shows.
     robots.get("robobee-wing").readouts["stroke_angle"](system)     # rad
 
 ``mjeap robot NAME [options]`` (or ``python scripts/NAME.py``) runs a robot's experiment.
-A new robot is one module here that calls :func:`register` (:mod:`mjeap.robots.registry`)
-and is named in ``_MODULES``.
+Each robot is a package here: its model (``model.py``: the builder and the read-outs, the
+size of a dm_control suite domain), its experiments (``experiments.py``: the studies and the
+command line) and its ``__init__.py``, which registers it (:func:`register`,
+:mod:`mjeap.robots.registry`) and holds the public names of both. A new robot is one more
+such package, named in ``_MODULES``; the list of robots is the registry's
+(:func:`names`), wherever it is shown.
 """
 from __future__ import annotations
 
@@ -19,7 +23,7 @@ from typing import Dict, List, Optional
 from ..errors import ParameterError, UnknownNameError
 from .registry import _REGISTRY, Robot, register, summary
 
-#: the modules that register the robots, imported on first use (they import SciPy and MjSpec code)
+#: the packages that register the robots, imported on first use (they import SciPy and MjSpec code)
 _MODULES = ("gripper", "hamr_leg", "hamr_walk", "robobee_wing")
 
 __all__ = ["Robot", "register", "names", "get", "load", "summary"]

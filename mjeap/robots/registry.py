@@ -1,5 +1,5 @@
-"""The robot registry's entries: a :class:`Robot` and :func:`register` (the modules of
-:mod:`mjeap.robots` call it at import)."""
+"""The robot registry's entries: a :class:`Robot` and :func:`register` (each robot package of
+:mod:`mjeap.robots` calls it at import, in its ``__init__.py``)."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field

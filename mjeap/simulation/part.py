@@ -23,7 +23,7 @@ from ..model.views import BeamView, as_slice, into, write_hinge_angles  # noqa: 
 
 
 class ActuatorPart:
-    """A beam in a compiled model. ``handles`` (:class:`mjeap.mjcf.BeamHandles`) name its
+    """A beam in a compiled model. ``handles`` (:class:`mjeap.model.mjcf.BeamHandles`) name its
     parts as built; ``prefix`` is prepended to every name (``'left/'`` after
     ``attach(prefix='left')``, empty for a :class:`Scene`). ``rotation`` (3 x 3) fixes the
     clamp frame where the clamp cannot move; None reads it from the clamp body."""
@@ -43,7 +43,7 @@ class ActuatorPart:
 
         body = lambda n: find(mujoco.mjtObj.mjOBJ_BODY, n)  # noqa: E731
         h = handles
-        #: the beam's representation (:class:`mjeap.mjcf.BeamBuilder`): how its bending is
+        #: the beam's representation (:class:`mjeap.model.mjcf.BeamBuilder`): how its bending is
         #: read, set and driven in this model (its :class:`BeamView`)
         self.builder = BUILDERS[representation]
         self.clamp_id = body(h.clamp_body)

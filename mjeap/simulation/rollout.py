@@ -65,7 +65,7 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     initial state included; the scene is left in the final state). With
     ``rrd`` a Rerun recording is written (also when the run fails or is stopped by Ctrl-C or
     SIGTERM: it then ends with the error), with ``csv_path`` the time series as CSV; a
-    second writer of either is refused (:func:`mjeap.outputs.guarded`). A diverging run raises
+    second writer of either is refused (:func:`mjeap.io.outputs.guarded`). A diverging run raises
     :class:`DivergenceError` naming the step, the drive and the timestep. ``engine``:
     'loop', 'threaded' (open-loop drives only, see the module) or 'auto'. Refused before
     any work: a duration shorter than a step, more than ``max_steps`` steps (default

@@ -3,7 +3,7 @@ loads, stepping with divergence checks, and SI read-outs.
 
 Damping and timestep are derived from the compiled model, never tuned by hand:
 
-1. Linearise (``mjeap.modes``) and find the first bending mode omega_1, phi_1 of the scene
+1. Linearise (``mjeap.model.modes``) and find the first bending mode omega_1, phi_1 of the scene
    (payload and gravity included), the first elastic mode omega_el (gravity's load left
    out) and the highest discrete mode.
 2. Joint damping is stiffness-proportional (Rayleigh), b_j = beta k_j with
@@ -72,7 +72,7 @@ DEFAULT_SEGMENTS = 20
 #: periods, and a damping ratio of a mode that does not oscillate means nothing
 NEAR_CRITICAL = 0.01
 #: a payload heavier than this many beams is probably a unit slip (kg for mg, a factor 1e6):
-#: warned. The HAMR leg's reflected leg mass is 4.7e4 beams (controllers/hamr_leg.py)
+#: warned. The HAMR leg's reflected leg mass is 4.7e4 beams (mjeap.controllers.hamr_leg)
 HEAVY_PAYLOAD = 1e5
 
 
@@ -124,7 +124,7 @@ class Scene:
     """A catalog actuator as a MuJoCo scene. Inputs and outputs in SI.
 
     Parameters: ``actuator`` (catalog id or :class:`Actuator`), ``representation``
-    ('hinge' | 'cable' | 'rod', :mod:`mjeap.mjcf`), ``segments`` (>= 2), ``orientation``
+    ('hinge' | 'cable' | 'rod', :mod:`mjeap.model.mjcf`), ``segments`` (>= 2), ``orientation``
     ('horizontal' | 'up' | 'down'), ``payload`` (:class:`Payload` or 'MASS@POSITION'),
     ``units`` (internal :class:`UnitSystem`), ``timestep`` (s, default from the model),
     ``integrator`` ('implicitfast' | 'discrete'; default the representation's own:
@@ -276,7 +276,7 @@ class Scene:
                       + ")")
         else:
             h = self.check_timestep(timestep) / u.time
-            reason = "chosen for an accuracy target (mjeap.accuracy)" if self.chosen_model else "given by the user"
+            reason = "chosen for an accuracy target (mjeap.simulation.accuracy)" if self.chosen_model else "given by the user"
         self.spec.option.timestep = h
         h_num = h if numerical else 0.0
         choice = TimestepChoice(
@@ -451,7 +451,7 @@ class Scene:
     # ------------------------------------------------------------------ the actuator (its part)
     def __getattr__(self, name):
         # the per-actuator state and read-outs live in the scene's one ActuatorPart
-        # (mjeap.component): hinge angles and rates, internal moments, stiffness, tip loads,
+        # (mjeap.simulation.part): hinge angles and rates, internal moments, stiffness, tip loads,
         # clamp-frame read-outs and the ids of the beam's bodies and joints
         if name == "part" or name.startswith("__"):
             raise AttributeError(name)

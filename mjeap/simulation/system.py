@@ -10,7 +10,7 @@ rotation at the host's ``qpos0``), so an attached actuator moves as its Scene do
 :class:`System` compiles the host with its attached actuators: the timestep is the
 smallest of the actuators' own choices (each already below its stability limit), contact
 parameters are set for micro scale (:class:`ContactParameters`), and the model declares its
-units in ``mjeap_units``. Each actuator is an :class:`~mjeap.component.ActuatorPart` with
+units in ``mjeap_units``. Each actuator is an :class:`~mjeap.simulation.part.ActuatorPart` with
 SI read-outs in its own clamp frame; rollouts take one voltage per actuator.
 
 Units: the host is written in the internal units the caller declares (``units``, default
@@ -365,7 +365,7 @@ def add_transmission(spec: mujoco.MjSpec, actuator: AttachedActuator, joint: str
 
 @dataclass
 class SystemResult:
-    """A system rollout, SI: one :class:`~mjeap.rollout.RolloutResult` per actuator (by
+    """A system rollout, SI: one :class:`~mjeap.simulation.rollout.RolloutResult` per actuator (by
     prefix, positions in its own clamp frame) and every body's world pose per sample."""
 
     time: np.ndarray                                  # (n,) s
@@ -646,7 +646,7 @@ class System:
         :class:`~mjeap.Waveform`, callable v(t) or None for its rest voltage; a list or a dict
         by prefix). Returns a :class:`SystemResult`; with ``rrd`` a Rerun recording (written
         also when the run fails or is stopped by Ctrl-C or SIGTERM: it then ends with the
-        error; a second writer is refused, :func:`mjeap.outputs.guarded`). ``on_sample(system)``
+        error; a second writer is refused, :func:`mjeap.io.outputs.guarded`). ``on_sample(system)``
         is called at every sample (e.g. to move a mocap body). ``controller(t, system)``
         (``voltages`` then None; a plain function or an object, the one contract of
         :func:`mjeap.rollout`, :func:`mjeap.engines.frame.check_controller`: its ``reset(system,

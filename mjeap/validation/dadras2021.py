@@ -2,9 +2,9 @@
 
 References: the paper's fitted step response (eq. 7) and transfer function (eq. 8, via
 scipy.signal.lsim) as published formulas; its piecewise-linear loaded model (Table I with eqs. 6
-and 8, transcribed in :class:`mjeap.analytical.DadrasModel`) as a published formula with the
+and 8, transcribed in :class:`mjeap.model.analytical.DadrasModel`) as a published formula with the
 paper's own model-vs-measurement error as tolerance; the relaxed column load (a characteristic
-equation solved by brentq, :func:`mjeap.analytical.critical_load_with_arm`) as an independent
+equation solved by brentq, :func:`mjeap.model.analytical.critical_load_with_arm`) as an independent
 solution; its stability statement and the other column loads as comparisons.
 """
 from __future__ import annotations
@@ -81,7 +81,7 @@ def payloads(quick: bool = False) -> Experiment:
             label = f"{m * 1e6:.2f} mg, {vpp:g} Vpp"
             ex.check(f"{label}: peak-to-peak, second period", "1/m", sim, ref,
                      f"{PAPER} Table I with eqs. (6) and (8): the paper's piecewise-linear closed-loop model "
-                     f"(transcribed in mjeap.analytical.DadrasModel; regions {sorted(set(regions))})",
+                     f"(transcribed in mjeap.model.analytical.DadrasModel; regions {sorted(set(regions))})",
                      tolerance=0.15, kind=PUBLISHED_FORMULA,
                      note="tolerance = the paper's reported model-vs-measurement error (< 15 %)")
             ex.check(f"{label}: peak-to-peak vs unloaded", "1/m", sim, unl[vpp],
@@ -160,7 +160,7 @@ def stability(quick: bool = False) -> Experiment:
         ex.check(f"{factor:g} x relaxed buckling load: buckled as the relaxed column predicts", "-",
                  float(grew), float(should_buckle),
                  "relaxed column load: k a tan(kL) = 1 for the payload on a rigid arm a = l_e - L (brentq, "
-                 "mjeap.analytical.critical_load_with_arm), EI x 0.3/0.52 = the DC stiffness of eq. (8)'s "
+                 "mjeap.model.analytical.critical_load_with_arm), EI x 0.3/0.52 = the DC stiffness of eq. (8)'s "
                  "mechanical block", tolerance=0.0, error_kind="absolute", kind=INDEPENDENT_SOLUTION)
         ex.rollouts.append((f"{factor:g} x relaxed load at 0 V", r, sc.rotation))
         ex.curve("sustained load at 0 V", f"mjeap, {factor:g} x relaxed column load", r.time, r.tip_curvature,

@@ -121,7 +121,7 @@ _HARVARD = ("Jafferis et al. 2015 as Harvard's HAMR actuator model writes it (PZ
 
 def closed_form_gains(act, f31: float, V: float):
     """(free deflection m, blocked force N) of the catalog bimorph ``act`` from the published
-    closed forms (mjeap.analytical), V the plates' voltage difference (V)."""
+    closed forms (mjeap.model.analytical), V the plates' voltage difference (V)."""
     lay = {l.name: l for l in act.layers}
     t_p, t_cf = lay["pzt-top"].thickness, lay["carbon-fibre"].thickness
     D = an.bimorph_stiffness_per_width(lay["pzt-top"].youngs_modulus, t_p, lay["carbon-fibre"].youngs_modulus, t_cf)

@@ -47,8 +47,8 @@ def free_vibration_frequency(scene, periods: int = 12) -> float:
 
 def _representations():
     """The beam representations this MuJoCo offers (the cable: 3.x only, the rod: 4.x only;
-    each builder says, mjeap.mjcf)."""
-    from ..mjcf import BUILDERS
+    each builder says, mjeap.model.mjcf)."""
+    from ..model.mjcf import BUILDERS
     return tuple(r for r, b in BUILDERS.items() if b.unavailable_reason() is None)
 
 

@@ -103,7 +103,7 @@ def write_recording(ex: Experiment, path: Path, figure: Optional[Path] = None) -
     curves against time as time series with fitted y axes, the report's figure as an image
     (``figure``: its PNG; curves against other quantities are best read there, with axes and
     units), without matplotlib those curves as a table, and the simulated beams in 3D.
-    Written whole (:func:`mjeap.outputs.replacing`)."""
+    Written whole (:func:`mjeap.io.outputs.replacing`)."""
     with replacing(path, "rrd") as tmp:
         _write_recording(ex, tmp, figure)
 

@@ -1,0 +1,294 @@
+"""The HAMR-VI walker's model (:mod:`mjeap.robots.hamr_walk`): its builder, its contact and
+its read-outs.
+
+Model (host in mm, mg, ms; gravity along -z; x forward, y left, z up):
+- Body: a free body (freejoint), BODY_LENGTH = 45.1 mm long, the whole robot TOTAL_MASS =
+  1.43 g (seed 003: "a 4.51 cm long, 1.43 g quadrupedal microrobot"); width 15 mm and height
+  4 mm ASSUMED; the body's own mass (a uniform box, 0.49 g) is what the eight actuators
+  (0.48 g) and the four legs (0.46 g) leave.
+- Legs: mjeap.robots.hamr_leg.add_leg with the single leg's design (hamr_leg.design():
+  joint inertias that put the loaded actuators at the transmission resonances, 100 Hz swing
+  and 80 Hz lift, zeta 0.05; T_swing = 13, T_lift = 12, seed 003 from its ref. [51];
+  LEG_LENGTH 10 mm, ASSUMED there), one per corner: hips at x = +-HIP_X (14 mm, ASSUMED),
+  y = +-7.5 mm (the body's sides), the rod outward along +-y, the foot FOOT_DROP = 11.35 mm
+  below its end on a massless shank (the foot's offset below its leg frame in N. Doshi's
+  HAMR-VI simulation model, HamrRBM.FOOT_POS, public Drake/MATLAB code; the shank leaves the
+  foot's fore-aft and normal motion per joint angle as the single leg's and adds a lateral
+  one, 11.35 mm per radian of lift). Mass radius LEG_LENGTH (the single leg's 2 mm would
+  make each leg weigh 1.8 g): each leg carries the single leg's inertias with 0.12 g.
+- Actuators: eight pzt-hamr-small (piezo-bimorph drive, bias 200 V), clamped on the body
+  (mount sites on it: the clamps ride with it), along x in the body's horizontal plane (their
+  bending plane; gravity along their hinge axes), the front legs' pointing forward, the
+  rear legs' backward; ``contact=False`` (the beams lie inside the chassis). SEGMENTS = 4 per
+  actuator: against 20, the single leg's foot gain moves by -0.05 % (swing) and -0.1 %
+  (lift) at 20 Hz, -0.4 % and -1.7 % at 65 Hz (2 segments: -1.2 % and -3.6 % at 65 Hz;
+  :func:`~mjeap.robots.hamr_walk.experiments.segment_effect`, on the single leg). Integrator
+  'discrete' (INTEGRATOR): the feet's contact forces reach the beams through the
+  transmissions, and under 'implicitfast' MuJoCo sizes contact impulses for M while the step
+  integrates M + hD (see mjeap.simulation.system.attach): with it the robot never came to
+  rest (:mod:`mjeap.robots.hamr_walk.experiments`). The step is then the discrete
+  integrator's beta / 2 = 4.51 us (beta = 2 zeta_1 / omega_1, the actuator's first mode;
+  10.4 us under implicitfast), 2-3 x the wall time.
+- Ground contact: the feet (spheres of FOOT_RADIUS = 0.5 mm, ASSUMED), the chassis box and
+  the legs' rods and shanks touch the ground plane (nothing else touches anything): a robot
+  that rolls over lands on its chassis or legs. Coulomb friction MU = 0.51 (the value of
+  Doshi's HAMR trot simulations; a parameter), elliptic cone, impratio 10. MuJoCo's soft
+  contact sized from the robot's physics in :func:`contact_parameters`: time constant
+  CONTACT_STEPS = 10 steps = 45 us (at least 10 steps; 5 tau within 5 % of the shortest
+  stance, 5 ms at 100 Hz; a landing at v penetrates v tau / e, 17 um per m/s), critically
+  damped, solimp (0.99, 0.999, 50 um): at rest each foot sinks 0.56 nm and creeps 0.12 um/s
+  under the legs' splay. The solimp width, 0.1 x FOOT_RADIUS = 50 um, is the contact
+  tolerance of the penetration checks.
+"""
+from __future__ import annotations
+
+from typing import Optional
+
+import mujoco
+import numpy as np
+
+from ...errors import ParameterError, check_integer, check_range
+from ...simulation.system import ContactParameters, System, attach
+from ..hamr_leg.model import ACTUATOR, LEG_LENGTH, add_leg, design
+
+TOTAL_MASS = 1.43e-3            # kg, seed 003
+BODY_LENGTH = 45.1e-3           # m, seed 003
+BODY_WIDTH = 15e-3              # m, assumed
+BODY_HEIGHT = 4e-3              # m, assumed
+HIP_X = 14e-3                   # m, assumed (hips 28 mm apart fore-aft)
+FOOT_DROP = 11.35e-3            # m, the foot below its leg frame in Doshi's HAMR model (see the module text)
+FOOT_RADIUS = 0.5e-3            # m, assumed
+MU = 0.51                       # sliding friction, as Doshi's HAMR trot simulations (see the module text)
+CONTACT_WIDTH_FRACTION = 0.1    # solimp width as a fraction of FOOT_RADIUS: the penetration tolerance
+IMPRATIO = 10.0                 # the friction rows' regulariser / 10: a sticking foot creeps 10 x less
+#: the contact's time constant in timesteps (contact_parameters: 10 h = 45 us at 4 segments)
+CONTACT_STEPS = 10.0
+#: the actuators' integrator: the feet's contact forces reach the beams through the
+#: transmissions, and 'implicitfast' sizes them for M alone (the feet chatter at rest)
+INTEGRATOR = "discrete"
+BIAS = 200.0                    # V, HAMR's drive bias (the brief's "paper's 200 V")
+SEGMENTS = 4
+FREQUENCY_RANGE = (1.0, 100.0)                # Hz, the trot frequencies the contact is sized for
+#: leg name -> (fore +1 / aft -1, side +1 left / -1 right, trot phase of its pair)
+LEGS = {"FL": (1, 1, 0.0), "FR": (1, -1, np.pi), "RL": (-1, 1, np.pi), "RR": (-1, -1, 0.0)}
+
+
+def build(mu: float = MU, segments: int = SEGMENTS, bias: float = BIAS, incline_deg: float = 0.0,
+          d: Optional[dict] = None, armature_fraction: float = 0.0, foot_drop: float = FOOT_DROP,
+          body_width: float = BODY_WIDTH, timeconst_steps: float = CONTACT_STEPS,
+          upside_down: bool = False, integrator: str = INTEGRATOR) -> System:
+    """The robot as a System (host in mm, mg, ms) standing on a ground plane tilted by
+    ``incline_deg`` about y (uphill along +x); ``d``: hamr_leg.design() (computed if None).
+
+    For the roll-over study (mjeap.robots.hamr_walk.study), each a model parameter whose
+    true value is not published: ``armature_fraction`` of each leg joint's design inertia
+    is carried as joint armature (a rotor on the joint: it enters that joint's own inertia
+    only, so the transmission resonances stay, but it exchanges no momentum with the body)
+    instead of by the leg's moving masses, whose masses scale by 1 - armature_fraction (the
+    body's own mass takes up the rest: the robot still weighs TOTAL_MASS); ``foot_drop`` (m):
+    the foot below the leg rod's end (its lateral motion per radian of lift); ``body_width``
+    (m): the chassis width, the hips at its sides; ``timeconst_steps``: the contact's time
+    constant in timesteps (ContactParameters; CONTACT_STEPS, see :func:`contact_parameters`).
+    ``upside_down``: the body starts turned 180 degrees about x, its chassis 20 um above the
+    ground (the rolled-over robot). ``integrator``: the actuators' ('discrete', INTEGRATOR:
+    the feet's contacts reach the beams through the transmissions, see the module text)."""
+    mu = check_range("mu", mu, 0.0, 10.0)
+    segments = check_integer("segments", segments, 1, 40)
+    incline = np.radians(check_range("incline_deg", incline_deg, -45.0, 45.0, "deg"))
+    armature_fraction = check_range("armature_fraction", armature_fraction, 0.0, 1.0, hi_open=True)
+    foot_drop = check_range("foot_drop", foot_drop, 0.0, 0.05, "m")
+    body_width = check_range("body_width", body_width, 6e-3, 0.1, "m")
+    timeconst_steps = check_range("timeconst_steps", timeconst_steps, 2.0, 100.0)
+    if integrator not in ("discrete", "implicitfast"):
+        raise ParameterError("integrator", integrator, "'discrete' or 'implicitfast'")
+    d = design() if d is None else d
+    if armature_fraction:
+        d = {n: {**v, "joint_inertia_kg_m2": v["joint_inertia_kg_m2"] * (1.0 - armature_fraction)}
+             for n, v in d.items()}
+    spec = mujoco.MjSpec.from_string('<mujoco><option gravity="0 0 -9.80665e-3"/><worldbody/></mujoco>')
+    wb = spec.worldbody
+    # the ground: a plane turned about y by -incline (its +x rises), the robot on it
+    q_ground = [np.cos(-incline / 2), 0.0, np.sin(-incline / 2), 0.0]
+    wb.add_geom(name="ground", type=mujoco.mjtGeom.mjGEOM_PLANE, size=[200.0, 200.0, 1.0], quat=q_ground,
+                rgba=[0.85, 0.85, 0.8, 1], contype=0, conaffinity=1, condim=3)
+    mm = 1e3
+    L, W, H = BODY_LENGTH * mm, body_width * mm, BODY_HEIGHT * mm
+    hip_height = (foot_drop + FOOT_RADIUS) * mm + 0.02          # feet 20 um above the ground at the start
+    R_ground = np.zeros(9)
+    mujoco.mju_quat2Mat(R_ground, np.array(q_ground))
+    q_body = np.array(q_ground)
+    if upside_down:             # turned about x: the chassis (its top down) 20 um above the ground
+        hip_height = H + 0.02
+        mujoco.mju_mulQuat(q_body, np.array(q_ground), np.array([0.0, 1.0, 0.0, 0.0]))
+    body = wb.add_body(name="body", pos=(R_ground.reshape(3, 3) @ [0, 0, hip_height]).tolist(), quat=q_body.tolist())
+    body.add_freejoint(name="root")
+    # the chassis touches the ground (contype 1; the ground's conaffinity 1), nothing else: a
+    # robot that rolls over lands on it
+    box = body.add_geom(name="chassis", type=mujoco.mjtGeom.mjGEOM_BOX, size=[L / 2, W / 2, H / 2], pos=[0, 0, H / 2],
+                        mass=TOTAL_MASS * 1e6 / 2, rgba=[0.25, 0.3, 0.4, 0.5], contype=1, conaffinity=0,
+                        condim=3)
+    acts = {}
+    for leg, (fore, side, _) in LEGS.items():
+        for k, dof in enumerate(("swing", "lift")):
+            # clamps 2 mm either side of the middle, the beams running toward their hips
+            site = body.add_site(name=f"{leg}_{dof}_mount", pos=[fore * 2.0, side * (2.5 + 3.0 * k), H - 1.0 - 2.0 * k],
+                                 quat=[1, 0, 0, 0] if fore > 0 else [0, 0, 0, 1])
+            acts[f"{leg}_{dof}"] = attach(spec, ACTUATOR, site=site.name, prefix=f"{leg}_{dof}", contact=False,
+                                          drive_params={"bias": bias}, segments=segments, integrator=integrator)
+    for leg, (fore, side, _) in LEGS.items():
+        add_leg(spec, body, {dof: acts[f"{leg}_{dof}"] for dof in ("swing", "lift")}, d, prefix=f"{leg}/",
+                pos=[fore * HIP_X * mm, side * W / 2, 0.0], side=side, mass_radius=LEG_LENGTH * mm,
+                foot_drop=foot_drop * mm, foot_radius=FOOT_RADIUS * mm, foot_contact=True)
+        # the leg rod and the shank touch the ground too (a robot on its side lies on them)
+        for part in ("leg", "shank"):
+            g = spec.geom(f"{leg}/{part}")
+            if g is not None:
+                g.contype, g.conaffinity, g.condim = 1, 0, 3
+        if armature_fraction:
+            u0 = acts[f"{leg}_swing"].twin.units
+            for dof in ("swing", "lift"):
+                full = d[dof]["joint_inertia_kg_m2"] / (1.0 - armature_fraction)
+                spec.joint(f"{leg}/{dof}").armature = armature_fraction * full / (u0.mass * u0.length**2)
+    # the body's own mass: what the actuators and legs leave of TOTAL_MASS
+    m = spec.copy().compile()
+    bid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "body")
+    others = m.body_subtreemass[bid] - box.mass
+    own = TOTAL_MASS * 1e6 - others
+    if own <= 0:
+        raise ParameterError("TOTAL_MASS", TOTAL_MASS, f"more than the actuators and legs ({others * 1e-6:.4g} kg)")
+    box.mass = own
+    acts_list = list(acts.values())
+    u = acts_list[0].twin.units
+    h = min(a.twin.timestep for a in acts_list)
+    contact = contact_parameters(h, mu, timeconst_steps)
+    # System applies contact parameters only for actuators with contact: here the feet's
+    contact.apply(spec, h / u.time, FOOT_RADIUS / u.length, u.length)
+    return System(spec, acts_list, contact=contact)
+
+
+def contact_parameters(h: float, mu: float = MU, timeconst_steps: float = CONTACT_STEPS) -> ContactParameters:
+    """The feet's (and the chassis's) contact with the ground for a timestep ``h`` (s),
+    sized from the robot's physics: the window below (:func:`contact_sizing` gives its
+    numbers for a built robot; other ``timeconst_steps`` are for studies,
+    hamr_walk.study.contact_study).
+
+    solref = (tau, 1), tau = CONTACT_STEPS h = 45 us at the walker's h = 4.51 us (the
+    discrete integrator's beta / 2, beta = 2 zeta_1 / omega_1 of the actuator's first mode;
+    4.4-4.5 us for 2-20 segments). Critically damped: a landing foot does not rebound off
+    the contact itself (its penetration obeys r'' + 2 r' / tau + r / tau^2 = 0). The window:
+    - tau >= 10 h: MuJoCo integrates the contact's reference dynamics over the steps; at
+      its floor, 2 h, the normal and friction rows are deadbeat from one step to the next
+      (a projection, not a resolved response; under 'implicitfast' the 2-step contact left
+      the robot at rest with no foot down in 40 % of the steps, though the integrator was
+      the cause: under 'discrete' it rests, module text);
+    - 5 tau (the critically damped response within 4 %) <= 5 % of the shortest stance, half
+      a cycle at the command line's top frequency (100 Hz: 5 ms): tau <= 50 us;
+    - a foot landing at v penetrates at most v tau / e: 23 um at the 1.4 m/s landings of the
+      80 Hz, 20 V hops, within the solimp width (the contact tolerance, 50 um = 0.1 x the
+      foot radius; tau <= 97 us there).
+    solimp (dmin 0.99, dmax 0.999, width 50 um): at rest a foot carrying a quarter of the
+    weight (3.5 mN) on its effective mass (156 mg, MuJoCo's diagonal of the contact's
+    inverse inertia) sinks (1 - d) / d^2 x tau^2 F / m = 0.46 nm (0.56 measured, MuJoCo's
+    discrete step); as a spring that is 6e6 N/m against the legs' 9 N/m (k_foot: the body
+    bounces at 18-25 Hz on its legs, not on the contact). Friction: mu, elliptic cone,
+    impratio IMPRATIO: a sticking foot under a tangential force f creeps at about
+    (1 - d) / d x (f / m) x dmax tau / (2 impratio) (the legs splay under the weight, 0.21 of
+    it sideways on each foot: 0.12 um/s; impratio 1 would make it 10 x more)."""
+    steps = check_range("timeconst_steps", timeconst_steps, 2.0, 100.0)
+    return ContactParameters(friction=(mu, 5e-6, 1e-7), impratio=IMPRATIO, width_fraction=CONTACT_WIDTH_FRACTION,
+                             timeconst_steps=steps)
+
+
+def contact_sizing(system: System) -> dict:
+    """The numbers behind :func:`contact_parameters` for a built ``system`` (SI): the step,
+    the time constant (s and steps), 5 tau against the shortest stance (half a cycle at
+    FREQUENCY_RANGE's top), the penetration per m/s of landing speed (tau / e) against the
+    contact tolerance, and the landing speed at which they meet."""
+    o = system.model.opt
+    u = system.units
+    tau = float(o.o_solref[0]) * u.time
+    stance = 0.5 / FREQUENCY_RANGE[1]
+    tol = CONTACT_WIDTH_FRACTION * FOOT_RADIUS
+    return {"timestep_s": system.timestep, "timeconst_s": tau, "timeconst_steps": tau / system.timestep,
+            "dampratio": float(o.o_solref[1]), "solimp": [float(x) for x in o.o_solimp[:3]] + [float(o.o_solimp[3]),
+                                                                                             float(o.o_solimp[4])],
+            "shortest_stance_s": stance, "settling_5tau_over_stance": 5 * tau / stance,
+            "landing_penetration_m_per_m_s": tau / np.e, "contact_tolerance_m": tol,
+            "landing_speed_at_tolerance_m_s": tol * np.e / tau, "impratio": float(o.impratio)}
+
+
+def body_position(system: System) -> np.ndarray:
+    """The body's world position (m)."""
+    return system.data.body("body").xpos * system.units.length
+
+
+def body_rotation(system: System) -> np.ndarray:
+    """The body's world rotation (3 x 3)."""
+    return system.data.body("body").xmat.reshape(3, 3).copy()
+
+
+def feet(system: System) -> np.ndarray:
+    """The four feet's world positions (m), in LEGS order."""
+    return np.array([system.data.site(f"{leg}/foot").xpos for leg in LEGS]) * system.units.length
+
+
+def ground_rotation(system: System) -> np.ndarray:
+    """The ground plane's world rotation: its x uphill (forward), z its normal."""
+    return system.data.geom("ground").xmat.reshape(3, 3).copy()
+
+
+def clearances(system: System) -> tuple:
+    """The lowest point (m) above the ground plane of the chassis (its box's corners) and of
+    the legs (their rods' and shanks' capsules): negative where it is below the ground."""
+    m, d = system.model, system.data
+    g = d.geom("ground")
+    up, origin = g.xmat.reshape(3, 3)[:, 2], g.xpos
+    c = d.geom("chassis")
+    size = m.geom("chassis").size
+    corners = np.array([[sx, sy, sz] for sx in (-1, 1) for sy in (-1, 1) for sz in (-1, 1)]) * size
+    chassis = float(((c.xpos + corners @ c.xmat.reshape(3, 3).T - origin) @ up).min())
+    legs = np.inf
+    for leg in LEGS:
+        for part in ("leg", "shank"):
+            gid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, f"{leg}/{part}")
+            if gid < 0:
+                continue
+            r, half = m.geom_size[gid, 0], m.geom_size[gid, 1]
+            axis = d.geom_xmat[gid].reshape(3, 3)[:, 2]
+            ends = d.geom_xpos[gid] + np.outer([-half, half], axis)
+            legs = min(legs, float(((ends - origin) @ up).min() - r))
+    u = system.units.length
+    return chassis * u, legs * u
+
+
+def roll_pitch(R: np.ndarray, G: np.ndarray) -> tuple:
+    """Roll and pitch (rad) of a body rotation ``R`` relative to the ground's ``G``."""
+    Rr = G.T @ R
+    return float(np.arctan2(Rr[2, 1], Rr[2, 2])), float(np.arcsin(np.clip(-Rr[2, 0], -1, 1)))
+
+
+def model_summary(system: System) -> dict:
+    """Masses and dimensions of the built robot (SI), with what is cited and what assumed."""
+    m = system.model
+    u = system.units
+    mass = {}
+    for b in range(1, m.nbody):
+        name = mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b)
+        key = "body" if name == "body" else "actuators" if "_swing/" in name or "_lift/" in name else "legs"
+        mass[key] = mass.get(key, 0.0) + float(m.body_mass[b]) * u.mass
+    return {"total_mass_kg": float(m.body_subtreemass[1] * u.mass), "mass_kg": mass,
+            "body_length_m": BODY_LENGTH, "body_width_m": BODY_WIDTH, "body_height_m": BODY_HEIGHT,
+            "hip_x_m": HIP_X, "leg_length_m": LEG_LENGTH, "foot_drop_m": FOOT_DROP, "foot_radius_m": FOOT_RADIUS,
+            "timestep_s": system.timestep, "segments": system.parts[0].layout.segments,
+            "cited": {"total mass, body length, 0.5 m/s at 65 Hz, 22 deg": "seed 003 section 6.2 (Jayaram 2018)",
+                      "T_swing 13, T_lift 12, resonances 100 / 80 Hz": "seed 003 section 6.2 (its refs [51], [19])",
+                      "foot 11.35 mm below its leg frame, mu 0.51, drive ramped over 2 cycles":
+                          "N. Doshi's HAMR Drake simulation scripts (HamrRBM FOOT_POS, trot sweeps MU)"},
+            "assumed": ["body width and height", "hip spacing", "leg length (hamr_leg)", "foot radius",
+                        "the legs' mass radius (= leg length)",
+                        "contact: MuJoCo soft, elliptic cone, impratio 10, sized by contact_parameters"]}
+
+
+#: the robot's read-outs (SI): name -> f(system)
+READOUTS = {"body_position": body_position, "feet": feet,
+            "roll_pitch": lambda s: np.array(roll_pitch(body_rotation(s), ground_rotation(s)))}

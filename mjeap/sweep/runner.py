@@ -1,0 +1,458 @@
+"""Running a sweep: :func:`evaluate` runs one point into its row, :func:`run_sweep` many,
+on local processes or on Dask, streamed to CSV as they complete and resumable
+(:func:`read_results` reads the CSV back).
+
+Every finished point is appended to the CSV (and flushed) at once, keyed by a hash of its
+parameters (:func:`mjeap.sweep.design.point_id`), so an interrupted sweep keeps what finished
+and a rerun with the same file skips it. A point that fails (bad input, divergence) records
+its error in the ``error`` column instead of stopping the sweep.
+
+Executors: ``"processes"`` (``concurrent.futures``, the default), ``"serial"``, and
+``"dask"``: a ``distributed.Client`` on ``scheduler`` (an address such as
+``tcp://host:8786``) or, without one, on a ``LocalCluster`` of ``workers`` processes. The
+same code runs on all three; Dask is the optional ``sweep`` extra.
+"""
+from __future__ import annotations
+
+import io
+import json
+import os
+import stat
+import sys
+import time
+import traceback
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+from typing import List, Optional, Sequence
+
+from ..io import csvio
+from ..errors import (DivergenceError, MjeapError, OutputError, ParameterError, UnknownNameError, check_integer,
+                      sigterm_as_interrupt)
+from ..io.outputs import hold
+from . import metrics as _metrics      # its registries, read where a point runs
+from .design import (PARAMETERS, _check_names, _duration, _scene, _wave_text, check_design_size, check_settings,
+                     point_id, settings)
+from .metrics import check_metric_settings, metric_value
+
+EXECUTORS = ("processes", "serial", "dask")
+
+
+# ---------------------------------------------------------------- one point
+def evaluate(point: dict, metrics: Sequence[str] = ("peak_to_peak", "returns"), base: Optional[dict] = None,
+             rrd_dir: Optional[str] = None, error_model=None) -> dict:
+    """Run one point (``base`` filled in under it) and return its row: the parameters, the
+    metrics, ``error`` (empty when it ran), ``wall_s`` and ``point_id``. Never raises for a
+    failing point. At an accuracy target, ``error_model`` (a, b) replaces the point's pilots
+    (:func:`mjeap.simulation.accuracy.run_at_accuracy`) and the row's ``_error_model`` (not
+    a CSV column) holds the constants the point ran with."""
+    p = {**PARAMETERS, **(base or {}), **point}
+    row = {"point_id": point_id(point, base, metrics), **point, "error": "", "wall_s": 0.0,
+           "settings": json.dumps(settings(base, metrics), sort_keys=True, default=float)}
+    for m in metrics:
+        row[m] = ""
+    t0 = time.perf_counter()
+    try:
+        unknown = [m for m in metrics if m not in _metrics.METRICS]
+        if unknown:
+            raise UnknownNameError("metric", unknown[0], _metrics.METRICS)
+        scene = _scene(p)
+        for m in metrics:                   # the scene's own metrics first: no rollout for them
+            if m in _metrics.STATIC_METRICS:
+                row[m] = metric_value(m, _metrics.METRICS[m](None, p, scene))
+        dynamic = [m for m in metrics if m not in _metrics.STATIC_METRICS]
+        r = _run_point(p, scene, dynamic, rrd_dir, row["point_id"], error_model) if dynamic or rrd_dir else None
+        if r is not None and "accuracy" in r.meta:
+            e = r.meta["accuracy"].get("error_model")
+            row["_error_model"] = None if e is None else (e["spatial_a"], e["temporal_b_per_s"])
+        for m in dynamic:
+            row[m] = metric_value(m, _metrics.METRICS[m](r, p, scene))
+    except MjeapError as e:
+        row["error"] = f"{type(e).__name__}: {e}"
+        if "returns" in metrics and isinstance(e, DivergenceError):
+            row["returns"] = False
+    except Exception as e:  # a bug or a library error: keep the sweep going, keep the trace
+        row["error"] = f"{type(e).__name__}: {e} | {traceback.format_exc(limit=3)!r}"
+    row["wall_s"] = time.perf_counter() - t0
+    return row
+
+
+def _run_point(p: dict, scene, metrics: Sequence[str], rrd_dir, pid: str, error_model=None):
+    """The rollout of a point, sampled as its metrics need: every step (every k steps beyond
+    MAX_STEP_SAMPLES) for STEP_METRICS, sparsely where every metric reads only the run's end
+    (END_METRICS: the scene holds the end), else the rollout's default."""
+    from ..simulation.rollout import rollout
+    wave = _wave_text(p)
+    duration = _duration(p)
+    drive_params = {k[6:]: v for k, v in p.items() if k.startswith("drive.")}
+    rrd = None if rrd_dir is None else Path(rrd_dir) / f"point-{pid}.rrd"
+    stop = None if p["stop_when_periodic"] in (None, "") else float(p["stop_when_periodic"])
+    at_target = scene.accuracy is not None
+    interval = None
+    if any(m in _metrics.STEP_METRICS for m in metrics):
+        dt = scene.timestep
+        interval = dt * max(1, -(-int(round(duration / dt)) // _metrics.MAX_STEP_SAMPLES))
+    elif metrics and all(m in _metrics.END_METRICS for m in metrics) and not at_target and stop is None and rrd is None:
+        interval = duration / 8.0
+    return rollout(scene, wave, duration, drive_params=drive_params, initial_curvature=float(p["initial_curvature"]),
+                   progress=False, rrd=rrd, engine=p["engine"], sample_interval=interval,
+                   error_model=error_model if at_target else None, stop_when_periodic=stop)
+
+
+# ---------------------------------------------------------------- many points
+@dataclass
+class SweepSummary:
+    path: Path
+    done: int
+    skipped: int
+    failed: int
+    wall_s: float
+
+    @property
+    def throughput(self) -> float:
+        """Rollouts per second of wall time (points run in this call)."""
+        return self.done / self.wall_s if self.wall_s > 0 else float("nan")
+
+
+def _drop_torn_row(path: Path) -> None:
+    """A file cut mid-line (a killed writer) loses its partial last row, which would
+    otherwise count as done and have the next row glued onto it; the point runs again."""
+    if not path.exists() or path.stat().st_size == 0:
+        return
+    with open(path, "rb+") as fh:
+        data = fh.read()
+        if data.endswith(b"\n"):
+            return
+        cut = data.rfind(b"\n") + 1
+        fh.truncate(cut)
+    warnings.warn(f"{path}: dropped a partial last row ({len(data) - cut} bytes, cut mid-line); its point runs again",
+                  stacklevel=3)
+
+
+def _read_sweep_csv(path):
+    """A sweep's CSV read as :mod:`mjeap.io.csvio` reads users' files (a UTF-8 BOM, ',', ';'
+    or tab as the delimiter: a file re-saved by a spreadsheet): (header, rows as dicts,
+    delimiter). Refused, naming the file, where its first row does not name ``point_id`` (the
+    header was lost or replaced: the points done could not be told)."""
+    rows, delimiter = csvio.read_table(path, "path")
+    header = rows[0]
+    if "point_id" not in header:
+        shown = ", ".join(header[:3]) + (", ..." if len(header) > 3 else "")
+        raise ParameterError("path", str(path), "a sweep CSV whose first row is the header mjeap wrote, naming "
+                             "point_id (the key of each point done)", f"its first row is [{shown}]: the header row "
+                             "was lost or changed (re-saved by a spreadsheet?); restore it, or start a new file")
+    pad = [""] * len(header)
+    return header, [dict(zip(header, r + pad[len(r):])) for r in rows[1:]], delimiter
+
+
+def read_results(path) -> List[dict]:
+    """Rows of a sweep CSV (strings, as given: the quote that keeps a spreadsheet from
+    running a text cell as a formula is dropped; a BOM, ';' or tab delimiters of a file
+    re-saved by a spreadsheet are read, :mod:`mjeap.io.csvio`; the header names the columns
+    and must name ``point_id``, else a ParameterError names the file)."""
+    if Path(path).is_file() and Path(path).stat().st_size == 0:
+        return []
+    return _read_sweep_csv(path)[1]
+
+
+def _die_with_parent() -> None:
+    """Linux: the kernel kills this worker when its parent dies (kill -9 of the sweep), so no
+    orphan keeps running with the CSV's points."""
+    try:
+        import ctypes
+        import signal
+        ctypes.CDLL("libc.so.6", use_errno=True).prctl(1, signal.SIGKILL)   # PR_SET_PDEATHSIG
+    except (OSError, AttributeError):   # pragma: no cover - not Linux
+        pass
+
+
+def worker_signals() -> None:
+    """Process-pool initializer: the worker dies with its parent (:func:`_die_with_parent`),
+    ignores Ctrl-C (the terminal sends it to the whole process group; the parent stops its
+    workers) and takes SIGTERM's default action (a forked worker inherits the parent's
+    :class:`~mjeap.errors.sigterm_as_interrupt` handler, which would print a traceback when
+    the parent terminates it)."""
+    import signal
+    _die_with_parent()
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    sigterm_as_interrupt.in_pool_worker = True       # a run's guard inside the worker leaves SIGTERM alone
+
+
+def stop_workers(executor) -> None:
+    """Stop a ProcessPoolExecutor now: terminate its processes (the points in flight are
+    not waited for) and shut it down without waiting."""
+    for proc in list((getattr(executor, "_processes", None) or {}).values()):
+        proc.terminate()
+    executor.shutdown(wait=False, cancel_futures=True)
+
+
+def _worker_init() -> None:
+    worker_signals()
+    _one_blas_thread()
+
+
+def _one_blas_thread() -> None:
+    """Process-pool initializer: one BLAS thread per worker. A point's linear algebra is on
+    matrices of a few dozen rows, where OpenBLAS's threads only cost; with one pool of them
+    per worker the workers also fight over the cores (measured, 32 points on 2 cores: 2
+    workers gave 1.2x one worker with BLAS threads, 1.8x without). Dask's nanny does the
+    same for its workers (OPENBLAS_NUM_THREADS=1)."""
+    from threadpoolctl import threadpool_limits
+    threadpool_limits(1)
+
+
+#: parameters that change the size of a point's loads, not the kind of its question: points
+#: that differ only in these share one accuracy error model (:func:`_with_shared_error_models`)
+LOAD_SIZE = ("payload_mass", "amplitude", "offset", "initial_curvature")
+
+
+def _family(job) -> Optional[str]:
+    """The accuracy family of a job: its parameters less LOAD_SIZE, or None without a target."""
+    p = {**PARAMETERS, **(job[2] or {}), **job[0]}
+    if p["accuracy"] in (None, ""):
+        return None
+    return json.dumps({k: v for k, v in p.items() if k not in LOAD_SIZE}, sort_keys=True, default=float)
+
+
+def _with_shared_error_models(executor: str, workers: int, scheduler: Optional[str], jobs):
+    """Yield finished rows. At an accuracy target the first point of each family (the same
+    question but for LOAD_SIZE) runs first with its own pilots; the family's other points
+    start from its error model (a, b) instead of pilots of their own, their error still
+    measured on each (:func:`mjeap.simulation.accuracy.run_at_accuracy`). Points of a
+    family whose first point failed run their own pilots. Points without a target run
+    beside the first points."""
+    first, rest, seen, lead_family = [], [], set(), {}     # lead_family: a first point's id -> its family
+    for job in jobs:
+        key = _family(job)
+        if key is not None and key in seen:
+            rest.append((key, job))
+            continue
+        if key is not None:
+            seen.add(key)
+            lead_family[point_id(job[0], job[2], job[1])] = key
+        first.append(job)
+    if not lead_family:
+        yield from _submit_all(executor, workers, scheduler, jobs)
+        return
+    models = {}
+    for row in _submit_all(executor, workers, scheduler, first):
+        if row["point_id"] in lead_family:
+            models[lead_family[row["point_id"]]] = row.get("_error_model")
+        yield row
+    yield from _submit_all(executor, workers, scheduler,
+                           [tuple(job[:4]) + (models.get(key),) for key, job in rest])
+
+
+def _submit_all(executor: str, workers: int, scheduler: Optional[str], jobs):
+    """Yield finished rows as they complete."""
+    if executor == "serial":
+        from threadpoolctl import threadpool_limits
+        with threadpool_limits(1):
+            for args in jobs:
+                yield evaluate(*args)
+        return
+    if executor == "processes":
+        yield from _run_processes(list(jobs), workers)
+        return
+    if executor == "dask":  # run_sweep has checked the name
+        try:
+            from distributed import Client, LocalCluster, as_completed
+        except ImportError:
+            raise ParameterError("executor", "dask", "an installed Dask: pip install -e '.[sweep]'") from None
+        cluster = None
+        if scheduler:
+            client = Client(scheduler)
+        else:
+            cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True,
+                                   dashboard_address=None)
+            client = Client(cluster)
+        try:
+            futures = [client.submit(evaluate, *args, pure=False) for args in jobs]
+            for fut in as_completed(futures):
+                yield fut.result()
+        finally:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+
+
+WORKER_DIED = ("worker process died while running this point (killed, e.g. by the out-of-memory killer, "
+               "or crashed); run alone after the pool broke, it died again")
+
+
+def _run_processes(jobs: list, workers: int):
+    """Local worker processes, at most ``workers`` points in flight. A worker that dies
+    breaks the pool: the points then in flight are run again one by one in a fresh
+    single-worker pool (the one that kills its worker again is recorded as failed), and the
+    sweep goes on in a fresh pool. Ctrl-C or SIGTERM cancels what has not started."""
+    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
+    from concurrent.futures.process import BrokenProcessPool
+    import multiprocessing as mp
+    # fork where there is one (fast start, works from any __main__), spawn elsewhere
+    ctx = mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn")
+
+    def pool(n):
+        return ProcessPoolExecutor(max_workers=n, mp_context=ctx, initializer=_worker_init)
+
+    pending = list(jobs)
+    while pending:
+        suspects, ex = [], pool(workers)
+        inflight = {}
+        try:
+            while pending or inflight:
+                broken = False
+                while pending and len(inflight) < workers:
+                    try:                    # the pool may break between a finished point and this submit
+                        fut = ex.submit(evaluate, *pending[0])
+                    except BrokenProcessPool:
+                        broken = True
+                        break
+                    inflight[fut] = pending.pop(0)
+                done, _ = wait(inflight, return_when=FIRST_COMPLETED)
+                for fut in done:
+                    args = inflight.pop(fut)
+                    try:
+                        yield fut.result()
+                    except BrokenProcessPool:
+                        suspects.append(args)
+                if suspects or broken:
+                    suspects += list(inflight.values())
+                    break
+        except BaseException:               # Ctrl-C, SIGTERM, the caller closing: stop the workers now
+            stop_workers(ex)
+            raise
+        else:
+            ex.shutdown(wait=not suspects, cancel_futures=True)
+        for args in suspects:                      # one by one: find the point that kills
+            alone = pool(1)
+            try:
+                yield alone.submit(evaluate, *args).result()
+            except BrokenProcessPool:
+                point = args[0]
+                yield {"point_id": point_id(point, args[2], args[1]), **point, "error": f"WorkerDied: {WORKER_DIED}",
+                       "wall_s": 0.0, "settings": json.dumps(settings(args[2], args[1]), sort_keys=True, default=float)}
+            finally:
+                alone.shutdown(wait=False, cancel_futures=True)
+
+
+def run_sweep(points: Sequence[dict], path, metrics: Sequence[str] = ("peak_to_peak", "returns"),
+              base: Optional[dict] = None, executor: str = "processes", workers: int = 2,
+              scheduler: Optional[str] = None, record: Sequence[int] = (), rrd_dir=None,
+              progress: Optional[bool] = None, share_error_models: bool = True) -> SweepSummary:
+    """Evaluate ``points`` and stream one CSV row per finished point to ``path``. Points
+    already in the file (same ``point_id``) are skipped. ``record``: indices of points
+    that also write a recording to ``rrd_dir`` (default: next to the CSV).
+    ``share_error_models`` (at an accuracy target): points differing only in LOAD_SIZE
+    start from their family's first point's error model instead of pilots of their own
+    (:func:`_with_shared_error_models`); each point's error is measured on it either way."""
+    path = Path(path)
+    if executor not in EXECUTORS:
+        raise ParameterError("executor", executor, f"one of {', '.join(EXECUTORS)}")
+    if int(workers) < 1:
+        raise ParameterError("workers", workers, "a positive number of worker processes")
+    unknown = [m for m in metrics if m not in _metrics.METRICS]
+    if unknown:
+        raise UnknownNameError("metric", unknown[0], _metrics.METRICS)
+    points = list(points)
+    check_design_size(len(points), "points")
+    for p in points:
+        _check_names(p)
+    if isinstance(record, (str, bytes, int)):
+        raise ParameterError("record", record, "a list of point indices, e.g. [0, 5]")
+    n = len(points)
+    record = [check_integer("record", i, 0, n - 1, f"indices of the sweep's {n} point{'s' * (n != 1)}")
+              for i in record]
+    check_settings(points, base)
+    check_metric_settings(points, base, metrics)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    # the CSV's lock for the whole sweep (PATH.lock): a second sweep on it, or a run writing it,
+    # is refused (it would compute every point twice and duplicate rows)
+    with hold(path, "path", holder="mjeap sweep"):
+        return _run_locked(points, path, metrics, base, executor, workers, scheduler, record, rrd_dir, progress,
+                           bool(share_error_models))
+
+
+def _run_locked(points, path, metrics, base, executor, workers, scheduler, record, rrd_dir, progress, share=True):
+    _drop_torn_row(path)
+    done_ids, header, delimiter = set(), None, ","
+    if path.exists() and path.stat().st_size > 0:       # resumed: read as users' CSVs are, appended in its form
+        header, rows, delimiter = _read_sweep_csv(path)
+        done_ids = {row["point_id"] for row in rows}
+    rrd_dir = str(rrd_dir or path.parent / (path.stem + "-rrd"))
+    record = set(int(i) for i in record)
+    jobs = [(p, tuple(metrics), base, rrd_dir if i in record else None) for i, p in enumerate(points)
+            if point_id(p, base, metrics) not in done_ids]
+    skipped = len(points) - len(jobs)
+    columns = ["point_id", *sorted({k for p in points for k in p}), *metrics, "error", "wall_s", "settings"]
+    path.parent.mkdir(parents=True, exist_ok=True)
+    new_file = not path.exists() or path.stat().st_size == 0
+    if not new_file:
+        if header != columns:
+            raise ParameterError("path", str(path), f"a CSV of this sweep (columns {columns}); it has {header}")
+    bar = None
+    if progress or (progress is None and sys.stderr.isatty()):      # no bar flooding a log file
+        try:
+            from tqdm import tqdm
+            bar = tqdm(total=len(jobs), unit="point", desc="sweep")
+        except ImportError:  # pragma: no cover
+            bar = None
+    t0 = time.perf_counter()
+    with sigterm_as_interrupt():
+        return _write_rows(path, columns, new_file, executor, workers, scheduler, jobs, bar, skipped, t0, share,
+                           delimiter)
+
+
+class _RowFile:
+    """The sweep's CSV, appended one whole row at a time: a row is formatted first, then
+    written and fsynced; a write that fails (a full disk) cuts the file back to its last
+    whole row and raises :class:`OutputError` saying how many rows are kept, so that a rerun
+    resumes from them (a stream, e.g. /dev/stdout, is written through)."""
+
+    def __init__(self, path: Path, delimiter: str = ","):
+        self.path = path
+        self.fd = os.open(path, os.O_WRONLY | os.O_APPEND | os.O_CREAT | os.O_CLOEXEC, 0o666)
+        self.regular = stat.S_ISREG(os.fstat(self.fd).st_mode)
+        self.buf = io.StringIO()
+        self.writer = csvio.writer(self.buf, delimiter=delimiter)
+
+    def write(self, cells, kept: int) -> None:
+        self.buf.seek(0)
+        self.buf.truncate()
+        self.writer.writerow(cells)
+        data = memoryview(self.buf.getvalue().encode("utf-8"))
+        end = os.lseek(self.fd, 0, os.SEEK_END) if self.regular else None
+        try:
+            while data:
+                data = data[os.write(self.fd, data):]
+            if self.regular:
+                os.fsync(self.fd)
+        except OSError as e:
+            if self.regular:
+                os.ftruncate(self.fd, end)
+            raise OutputError([(str(self.path), f"{e.strerror or e}; the {kept} whole rows written so far are "
+                                               "kept: rerun the same sweep to resume from them")]) from None
+
+    def close(self) -> None:
+        os.close(self.fd)
+
+
+def _write_rows(path, columns, new_file, executor, workers, scheduler, jobs, bar, skipped, t0, share=True,
+                delimiter=","):
+    failed, done = 0, 0
+    out = _RowFile(path, delimiter)
+    try:
+        if new_file:
+            out.write(columns, 0)
+        rows = _with_shared_error_models if share else _submit_all
+        for row in rows(executor, int(workers), scheduler, jobs):
+            out.write([row.get(k, "") for k in columns], done + skipped)
+            done += 1
+            failed += bool(row["error"])
+            if bar is not None:
+                bar.update(1)
+    finally:
+        out.close()
+        if bar is not None:
+            bar.close()
+    return SweepSummary(path, done, skipped, failed, time.perf_counter() - t0)
