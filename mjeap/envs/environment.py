@@ -1,11 +1,24 @@
-"""A dm_env environment through dm_control: ``control.Environment`` with a :class:`Task`.
+"""The dm_env environment: curvature tracking with one bending actuator, on MuJoCo 3.17 and 4.x.
 
-:class:`BeamPhysics` is a dm_control ``Physics`` on a :class:`mjeap.Scene`'s model and data
-whose ``step`` runs the drive in lockstep with MuJoCo (one drive update per MuJoCo step,
-the voltage held over the control interval), so ``control.Environment``'s sub-steps keep the
-drive exact. :class:`CurvatureTrackingTask` gives the action (drive voltage, V, inside the
-drive's safe range), the observations (SI) and a configurable tracking reward, and
-randomises payload mass and initial curvature per episode from its seeded generator.
+:func:`make_environment` is the entry point (``mjeap.make_environment``). It returns a
+``dm_env.Environment`` posed by :class:`CurvatureTrackingTask` on a :class:`BeamPhysics`
+(a :class:`mjeap.Scene`'s model and data whose ``step`` runs the drive in lockstep with
+MuJoCo: one drive update per MuJoCo step, the voltage held over the control interval):
+
+* ``backend="dm_control"``: dm_control's ``control.Environment`` with the task and physics
+  as dm_control's ``Task`` and ``Physics`` (:mod:`mjeap.envs.dm_control_env`), where
+  dm-control's ``Physics`` loads the model (MuJoCo 3.x);
+* ``backend="dm_env"``: :class:`TrackingEnvironment`, the same episode, step and time limit
+  written on ``dm_env.Environment`` directly (no dm_control), which runs everywhere;
+* ``backend="auto"`` (default): dm_control where it can run, else dm_env: on MuJoCo 4.0
+  dm-control 1.0.50's ``Physics`` reads ``MjModel.flex_vertedge``, which 4.0 no longer has
+  (:func:`mjeap.versions.dm_control_problem`).
+
+Both give the same trajectories for the same seed and actions (tests/test_environment.py).
+The task, the physics and the dm_env environment are :mod:`mjeap.envs.dm_tracking`'s (no
+dm_control). :class:`CurvatureTrackingTask` gives the action (drive voltage, V, inside the drive's safe
+range), the observations (SI) and a configurable tracking reward, and randomises payload
+mass and initial curvature per episode from its seeded generator.
 
 The payload is randomised in place (``model.body_mass`` and its inertia, then
 ``mj_setConst``): timestep and Rayleigh damping stay those chosen for the scene's nominal
@@ -17,125 +30,24 @@ from __future__ import annotations
 import argparse
 from typing import Callable, Optional, Tuple
 
+import dm_env
 import numpy as np
-from dm_control.mujoco import engine, wrapper
-from dm_control.rl import control
-from dm_control.suite import base
-from dm_env import specs
 
-from ..errors import install_mujoco_warnings
 from ..io.commandline import arg_integer, arg_number, arg_output, parse_args
 from ..model.discretize import Payload
 from ..drives import make_drive
-from ..errors import MjeapError, check_positive, check_range
+from ..errors import ParameterError, check_range
 from ..io.outputs import guarded, provenance
 from ..simulation.scene import Scene
-from .tracking import (check_curvature_range, check_mass_range, default_reference, draw_episode, observe, step_lockstep, tracking_reward, VoltageLimiter, warn_heavy_range)
+from .dm_tracking import BeamPhysics, CurvatureTrackingTask, TrackingEnvironment, check_dm_control
+from .tracking import check_curvature_range, check_mass_range, default_reference, warn_heavy_range
 from ..versions import dm_control_problem
 
-install_mujoco_warnings()         # dm_control's import installed its own MuJoCo warning handler
+__all__ = ["make_environment", "run_episode", "BeamPhysics", "CurvatureTrackingTask", "TrackingEnvironment",
+           "BACKENDS", "main"]
 
-
-class BeamPhysics(engine.Physics):
-    """dm_control Physics sharing a Scene's MjModel and MjData; stepping also steps the drive."""
-
-    @classmethod
-    def from_scene(cls, scene: Scene, drive) -> "BeamPhysics":
-        check_dm_control()
-        physics = cls.from_model(wrapper.MjModel(scene.model))
-        scene.data = physics.data.ptr       # the scene's read-outs now see the physics' state
-        physics.scene, physics.drive, physics.voltage = scene, drive, 0.0
-        return physics
-
-    def timestep(self) -> float:
-        """MuJoCo timestep in s (the model runs in scaled internal units)."""
-        return self.scene.timestep
-
-    def time(self) -> float:
-        """Simulated time in s."""
-        return self.scene.time
-
-    def step(self, nstep: int = 1) -> None:
-        with self.check_invalid_state():
-            step_lockstep(self.scene, self.drive, self.voltage, nstep)     # on the physics' model and data
-        self.scene.check_finite()
-        self.scene.update_kinematics()
-
-
-class CurvatureTrackingTask(base.Task):
-    """Track ``reference(t)`` (1/m) with the tip curvature. Reward per step:
-    ``reward_fn(kappa, kappa_ref)``, default a Gaussian of the error with width
-    ``reward_margin`` (1/m), 1 on target (dm_control.utils.rewards.tolerance).
-
-    Randomised at every reset (``random``: seed or numpy Generator/RandomState): the payload
-    mass uniformly in ``payload_mass_range`` (kg, needs a scene with a payload), the initial
-    curvature uniformly in ``initial_curvature_range`` (1/m, both bounds within rollout's:
-    finite, at most a full circle over the beam). An action is one voltage (shape (1,));
-    more values are refused, not cut. Actions outside the safe range
-    are clipped, counted in ``saturated_steps`` and warned about once per episode."""
-
-    def __init__(self, reference: Callable[[float], float], payload_mass_range: Optional[Tuple[float, float]] = None,
-                 initial_curvature_range: Tuple[float, float] = (0.0, 0.0), reward_margin: float = 5.0,
-                 reward_fn: Optional[Callable[[float, float], float]] = None, random=None):
-        super().__init__(random=random)
-        self.reference = reference
-        self.payload_mass_range = check_mass_range(payload_mass_range)
-        self.initial_curvature_range = check_curvature_range(initial_curvature_range, None)   # bounds: per beam
-        self.reward_margin = check_positive("reward_margin", reward_margin, "1/m")
-        self.reward_fn = reward_fn
-        self.limiter = VoltageLimiter("the action_spec")
-        self.episode = {}
-
-    @property
-    def saturated_steps(self) -> int:
-        """Actions clipped to the safe range in this episode."""
-        return self.limiter.saturated_steps
-
-    # -- episode -----------------------------------------------------------------------
-    def initialize_episode(self, physics: BeamPhysics) -> None:
-        sc = physics.scene
-        sc.part.after_data_reset()          # Physics.reset cleared xfrc_applied: the tip loads persist
-        check_curvature_range(self.initial_curvature_range, sc.layout.length)
-        self.episode = draw_episode(sc, self.random, self.payload_mass_range, self.initial_curvature_range)
-        kappa0 = self.episode["initial_curvature_per_m"]
-        if kappa0:
-            sc.set_hinge_angles(np.full(sc.layout.segments, kappa0 * sc.layout.ds))
-        sc._step_count = 0
-        physics.drive.reset(kappa0)
-        physics.voltage = physics.drive.rest_voltage()
-        self.limiter.reset()
-        self._signal_names = list(physics.drive.signals())
-
-    def action_spec(self, physics: BeamPhysics):
-        lo, hi = physics.drive.voltage_range()
-        return specs.BoundedArray((1,), np.float64, lo, hi, name="voltage (V)")
-
-    def before_step(self, action, physics: BeamPhysics) -> None:
-        physics.voltage = self.limiter(action, physics.drive)
-
-    # -- read-outs ---------------------------------------------------------------------
-    def get_observation(self, physics: BeamPhysics):
-        """tip_curvature (1/m), reference (1/m), tip_position (m, clamp frame), drive_state
-        (SI, see drive_state_names) and current (A) where the drive reports one."""
-        return observe(physics.scene, physics.drive, self.reference, self._signal_names)
-
-    @property
-    def drive_state_names(self):
-        return list(self._signal_names)
-
-    def get_reward(self, physics: BeamPhysics) -> float:
-        sc = physics.scene
-        k, ref = sc.tip_curvature(), float(self.reference(sc.time))
-        if self.reward_fn is not None:
-            return float(self.reward_fn(k, ref))
-        return tracking_reward(k, ref, self.reward_margin)
-
-
-def check_dm_control() -> None:
-    """Refuse, naming the versions, where dm_control's Physics cannot run on this MuJoCo."""
-    why = dm_control_problem()
-    if why:
-        raise MjeapError(f"no dm_env environment here: {why}")
+#: make_environment's backends: dm_control's control.Environment, or dm_env's interface directly
+BACKENDS = ("auto", "dm_control", "dm_env")
 
 
 def make_environment(actuator: str = "pedot-micro", reference: Optional[Callable[[float], float]] = None,
@@ -143,26 +55,37 @@ def make_environment(actuator: str = "pedot-micro", reference: Optional[Callable
                      payload_mass_range: Optional[Tuple[float, float]] = None,
                      initial_curvature_range: Tuple[float, float] = (0.0, 0.0), control_interval: float = 1e-2,
                      time_limit: float = 20.0, seed=None, drive: Optional[str] = None, drive_params=None,
-                     reward_margin: float = 5.0, segments: int = 20) -> control.Environment:
-    """A ``dm_control.rl.control.Environment`` tracking ``reference(t)`` (1/m; default: a
-    0.05 Hz sine of 50 1/m, seed 000's closed-loop case) with ``actuator``. The agent acts
-    every ``control_interval`` s (rounded to whole MuJoCo steps) for ``time_limit`` s."""
-    check_dm_control()
+                     reward_margin: float = 5.0, segments: int = 20, backend: str = "auto") -> dm_env.Environment:
+    """A dm_env environment tracking ``reference(t)`` (1/m; default: a 0.05 Hz sine of 50
+    1/m, seed 000's closed-loop case) with ``actuator``. The agent acts every
+    ``control_interval`` s (rounded to whole MuJoCo steps) for ``time_limit`` s. ``backend``
+    (:data:`BACKENDS`): 'dm_control' (``control.Environment``, MuJoCo 3.x; refused naming the
+    versions where dm_control's Physics cannot run), 'dm_env' (:class:`TrackingEnvironment`,
+    any MuJoCo) or 'auto' (the first where it runs, else the second). Either has
+    ``physics`` (``scene``, ``drive``, ``voltage``, ``model``, ``data``, ``time()``), ``task``
+    and ``control_timestep()``."""
+    if backend not in BACKENDS:
+        raise ParameterError("backend", backend, f"one of {', '.join(map(repr, BACKENDS))}")
+    use_dm_control = backend == "dm_control" or (backend == "auto" and not dm_control_problem())
+    if use_dm_control:
+        check_dm_control()
     reference = default_reference if reference is None else reference
     scene = Scene(actuator, orientation=orientation, payload=payload, segments=segments)
     warn_heavy_range(check_mass_range(payload_mass_range), scene, 3)     # the Scene's unit check, on the draws
     check_curvature_range(initial_curvature_range, scene.layout.length)
     drv = make_drive(drive, scene, **(drive_params or {}))
     check_range("control_interval", control_interval, scene.timestep, time_limit, "s")
-    physics = BeamPhysics.from_scene(scene, drv)
-    task = CurvatureTrackingTask(reference, payload_mass_range, initial_curvature_range, reward_margin,
-                                 random=seed)
     n_sub = max(1, int(round(control_interval / scene.timestep)))
-    return control.Environment(physics, task, time_limit=time_limit, n_sub_steps=n_sub)
+    if use_dm_control:
+        from .dm_control_env import make_dm_control_environment
+        return make_dm_control_environment(scene, drv, reference, payload_mass_range, initial_curvature_range,
+                                           reward_margin, seed, time_limit, n_sub)
+    task = CurvatureTrackingTask(reference, payload_mass_range, initial_curvature_range, reward_margin, random=seed)
+    return TrackingEnvironment(BeamPhysics.from_scene(scene, drv), task, time_limit=time_limit, n_sub_steps=n_sub)
 
 
 @guarded("rrd")
-def run_episode(env: control.Environment, policy: Callable, rrd=None):
+def run_episode(env: dm_env.Environment, policy: Callable, rrd=None):
     """Run one episode of ``env`` with ``policy(time_step) -> action`` and return it as a
     :class:`mjeap.RolloutResult` sampled at every agent step (the reward and the action as
     signals), written to ``rrd`` if given (also when the episode fails or is stopped, by
