@@ -34,12 +34,20 @@ __all__ = ["CATALOG", "Actuator", "Layer", "Planform", "get_actuator", "actuator
 from .optimize import optimize  # noqa: E402  (design optimisation, mjeap.optimize)
 __all__.append("optimize")
 
+import importlib.util as _util  # noqa: E402
+
+if _util.find_spec("gymnasium") is not None:
+    # the Gymnasium ids, as entry-point strings: no environment module is imported here
+    from .envs.registration import register_envs as _register_envs
+    _register_envs()
+
 
 def __getattr__(name):
     """The environments at the top level, imported when first asked for (not by ``import
     mjeap``, nor by ``from mjeap import *``): ``mjeap.make_environment``
-    (:mod:`mjeap.envs.environment`, dm_control's) and ``mjeap.CurvatureTrackingEnv``
-    (:mod:`mjeap.envs.gymnasium_env`, the optional gymnasium's)."""
+    (:mod:`mjeap.envs.environment`, the dm_env environments on any MuJoCo) and
+    ``mjeap.CurvatureTrackingEnv`` (:mod:`mjeap.envs.gymnasium_env`, the optional gymnasium's;
+    ``import mjeap`` registers every Gymnasium id, :mod:`mjeap.envs.registration`)."""
     if name == "make_environment":
         from .envs.environment import make_environment
         return make_environment

@@ -40,7 +40,8 @@ def dm_control_problem() -> str:
     except Exception:  # pragma: no cover - not installed
         dmc = "?"
     return (f"dm-control {dmc}'s Physics reads MjModel.flex_vertedge, which MuJoCo {MUJOCO_VERSION} no longer has: "
-            "the dm_env environment needs MuJoCo 3.x (pip install 'mujoco>=3.17,<4')")
+            "dm_control's control.Environment needs MuJoCo 3.x (pip install 'mujoco>=3.17,<4'); "
+            "make_environment's dm_env backend runs here")
 
 
 def newton_sparse_broken() -> bool:

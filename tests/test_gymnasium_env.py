@@ -15,6 +15,8 @@ import mjeap.envs.gymnasium_env as ge  # noqa: E402
 from mjeap import MjeapError, ParameterError, Scene, rollout  # noqa: E402
 from mjeap.drives import DRIVES, Drive  # noqa: E402
 from mjeap.envs.gymnasium_env import ENV_ID, CurvatureTrackingEnv  # noqa: E402
+from mjeap.envs.registration import ENVS, register_envs  # noqa: E402
+from mjeap.envs.rendering import render_modes  # noqa: E402
 
 RANDOMISED = dict(payload_mass_range=(1e-6, 12.6e-6), initial_curvature_range=(-20.0, 20.0), time_limit=0.2)
 
@@ -22,25 +24,21 @@ RANDOMISED = dict(payload_mass_range=(1e-6, 12.6e-6), initial_curvature_range=(-
 @pytest.fixture(scope="module")
 def gl():
     """Whether mujoco.Renderer works here (MUJOCO_GL=egl or osmesa; CI runs with 'disable')."""
-    try:
-        CurvatureTrackingEnv(render_mode="rgb_array", width=8, height=8, time_limit=0.1).close()
-    except ParameterError:
-        return False
-    return True
+    return "rgb_array" in render_modes()
 
 
 @pytest.mark.parametrize("kw", [
     dict(actuator="pedot-micro", **RANDOMISED),
     dict(actuator="pzt-hamr-small", orientation="horizontal", payload=None, time_limit=2e-3, control_interval=1e-4,
          drive_params={"bias": 100.0}, reference=lambda t: 0.0)], ids=["pedot-micro", "pzt-hamr-small"])
-def test_gymnasium_check_env_passes(gl, kw):
-    """gymnasium's env_checker on the registered env (an ionic and a piezo drive); its only
-    warnings are its advice on the spaces (infinite observation bounds, an action in volts
-    rather than [-1, 1])."""
+def test_gymnasium_check_env_passes(kw):
+    """gymnasium's env_checker with its defaults on the registered env (an ionic and a piezo
+    drive; the render modes declared are those that work here); its only warnings are its
+    advice on the spaces (infinite observation bounds, an action in volts rather than [-1, 1])."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         env = gymnasium.make(ENV_ID, **kw)
-        check_env(env.unwrapped, skip_render_check=not gl)
+        check_env(env.unwrapped)
     advice = ("infinity", "symmetric and normalized")
     assert [str(w.message) for w in caught if not any(a in str(w.message) for a in advice)] == []
     env.close()
@@ -87,6 +85,39 @@ def test_make_and_make_vec_after_import():
     assert reward.shape == (2,) and not terminated.any() and not truncated.any()
     assert np.all((0 <= reward) & (reward <= 1))
     venv.close()
+
+
+def test_import_mjeap_registers_every_id_cheaply():
+    """``import mjeap`` registers every id under mjeap/ as an entry-point string: no
+    environment module, robot or dm_control is imported by it. In a fresh interpreter."""
+    code = ("import sys, gymnasium, mjeap; "
+            f"ids = sorted(i for i in gymnasium.registry if i.startswith('mjeap/')); assert ids == {sorted(ENVS)}, ids; "
+            "bad = [m for m in sys.modules if m.startswith(('mjeap.envs.', 'mjeap.robots', 'dm_control', 'dm_env')) "
+            "and m not in ('mjeap.envs.registration',)]; assert not bad, bad")
+    subprocess.run([sys.executable, "-c", code], check=True, timeout=120)
+
+
+def test_module_colon_id_imports_mjeap():
+    """Gymnasium 1.x's ``module:id`` form: ``gymnasium.make("mjeap:mjeap/CurvatureTracking-v0")``
+    without importing mjeap first. In a fresh interpreter."""
+    code = ("import gymnasium; env = gymnasium.make('mjeap:mjeap/CurvatureTracking-v0', time_limit=0.1); "
+            "env.reset(seed=0); env.step(env.action_space.sample()); env.close()")
+    subprocess.run([sys.executable, "-c", code], check=True, timeout=120)
+
+
+def test_the_gymnasium_entry_point():
+    """The package's ``gymnasium.envs`` entry point (Gymnasium 0.26-0.29's plugins) names
+    register_envs, in pyproject.toml and, where the installed mjeap declares it, in its
+    metadata; calling it again registers nothing new."""
+    import tomllib
+    from importlib import metadata
+    from pathlib import Path
+    project = tomllib.loads((Path(__file__).resolve().parent.parent / "pyproject.toml").read_text())["project"]
+    assert project["entry-points"]["gymnasium.envs"] == {"mjeap": "mjeap.envs.registration:register_envs"}
+    installed = [e for e in metadata.entry_points(group="gymnasium.envs") if e.name == "mjeap"]
+    for e in installed:
+        assert e.load() is register_envs
+    assert register_envs() == []
 
 
 def test_import_needs_no_dm_control_and_registers_once():
@@ -142,7 +173,7 @@ def test_bad_parameters_refused_before_any_work(monkeypatch):
             (dict(reward_margin=0.0), "reward_margin", "> 0"),
             (dict(time_limit=-1.0), "time_limit", "> 0"),
             (dict(control_interval=float("nan")), "control_interval", "> 0"),
-            (dict(render_mode="human"), "render_mode", "rgb_array"),
+            (dict(render_mode="bogus"), "render_mode", "in this process"),
             (dict(width=0), "width", "[1, 4096]"),
             (dict(reference=50.0), "reference", "callable")]:
         with pytest.raises(ParameterError, match=name) as e:

@@ -5,10 +5,11 @@ round a circle, lazy imports and ``importlib.import_module`` strings included), 
 has a floor, no test imports a script by path, and only ``mjeap`` is installed at the top.
 
 Floors, bottom up: the foundation (errors, units, versions), io, model, drives, engines,
-simulation, analysis; then the applications: controllers, envs (the dm_env and Gymnasium
-environments and their task), the studies (mjeap.design, the sweep package, optimize, the
-stability map), robots (a package each: model, experiments), validation (and the MJCF
-assets), cli, and last the package's top level (``mjeap``: the names most programs need)."""
+simulation, analysis; then the applications: controllers, the studies (mjeap.design, the
+sweep package, optimize, the stability map), robots (a package each: model, experiments),
+envs (the dm_env and Gymnasium environments: the tracking task and the robots as tasks, so
+above the robots), validation (and the MJCF assets), cli, and last the package's top level
+(``mjeap``: the names most programs need)."""
 import ast
 import re
 import tomllib
@@ -25,9 +26,9 @@ FLOORS = [
     ("simulation", ("mjeap.simulation",)),
     ("analysis", ("mjeap.analysis",)),
     ("controllers", ("mjeap.controllers",)),
-    ("envs", ("mjeap.envs",)),
     ("studies", ("mjeap.design", "mjeap.sweep", "mjeap.optimize", "mjeap.stability_map")),
     ("robots", ("mjeap.robots",)),
+    ("envs", ("mjeap.envs",)),
     ("validation", ("mjeap.validation", "mjeap.assets")),
     ("cli", ("mjeap.cli",)),
     ("top level", ("mjeap",)),
@@ -225,8 +226,9 @@ def test_the_graph_sees_the_layers():
     assert "mjeap.simulation.scene" in GRAPH["mjeap.simulation.rollout"]
     assert "mjeap.robots" in GRAPH["mjeap.cli"] and "mjeap.io.commandline" in GRAPH["mjeap.robots.hamr_leg.experiments"]
     order = [layer(m) for m in ("mjeap.engines.loop", "mjeap.simulation.system", "mjeap.analysis.frequency",
-                                "mjeap.controllers.hamr_leg", "mjeap.envs.gymnasium_env", "mjeap.sweep.runner",
-                                "mjeap.robots.hamr_leg.model", "mjeap.validation.core", "mjeap.cli", "mjeap")]
+                                "mjeap.controllers.hamr_leg", "mjeap.sweep.runner", "mjeap.robots.hamr_leg.model",
+                                "mjeap.envs.gymnasium_env", "mjeap.validation.core", "mjeap.cli", "mjeap")]
+    assert "mjeap.robots.hamr_walk.model" in GRAPH["mjeap.envs.hamr_walk"]      # a robot as a task
     assert order == sorted(order) and len(set(order)) == len(order)
     assert layer("mjeap.io.commandline") < layer("mjeap.model")
     assert len(MODULES) > 50

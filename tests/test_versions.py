@@ -40,10 +40,14 @@ def test_rod_on_mujoco_3_is_refused_naming_the_reason():
 
 
 @on_4
-def test_dm_env_on_mujoco_4_is_refused_naming_the_versions():
+def test_dm_control_on_mujoco_4_is_refused_naming_the_versions():
+    """dm_control's Physics cannot load there: backend='dm_control' is refused naming the
+    versions; the default runs the same task on dm_env's interface."""
+    from mjeap.envs.dm_tracking import TrackingEnvironment
     from mjeap.envs.environment import make_environment
-    with pytest.raises(MjeapError, match=r"dm-control .*MuJoCo 4.*mujoco>=3.17,<4"):
-        make_environment(time_limit=0.05)
+    with pytest.raises(MjeapError, match=r"dm-control .*MuJoCo 4.*mujoco>=3.17,<4.*dm_env backend runs here"):
+        make_environment(time_limit=0.05, backend="dm_control")
+    assert isinstance(make_environment(time_limit=0.05), TrackingEnvironment)
     assert "flex_vertedge" in dm_control_problem()
 
 

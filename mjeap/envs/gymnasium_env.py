@@ -4,18 +4,18 @@ and 4.x (no dm_control).
 :class:`CurvatureTrackingEnv` poses the task of the dm_env environment
 (:mod:`mjeap.envs.environment`) with the same pieces (:mod:`mjeap.envs.tracking`): the drive is stepped
 in lockstep with MuJoCo (one drive update per MuJoCo step, the voltage held over the control
-interval), SI at the API. Importing this module registers it as
-``mjeap/CurvatureTracking-v0``::
+interval), SI at the API. ``import mjeap`` registers it as ``mjeap/CurvatureTracking-v0``
+(:mod:`mjeap.envs.registration`)::
 
-    import gymnasium, mjeap.envs.gymnasium_env
+    import gymnasium, mjeap
     env = gymnasium.make("mjeap/CurvatureTracking-v0", actuator="pedot-micro")
 
-Rendering (``render_mode="rgb_array"``) needs an OpenGL backend chosen before mujoco is
-imported: ``MUJOCO_GL=egl`` or ``osmesa`` (mjeap sets ``disable`` when MUJOCO_GL is unset).
+Rendering: the modes that work in the process are declared (:mod:`mjeap.envs.rendering`):
+``rgb_array`` needs an OpenGL backend chosen before mujoco is imported, ``MUJOCO_GL=egl`` or
+``osmesa`` (mjeap sets ``disable`` when MUJOCO_GL is unset); ``human`` a display.
 """
 from __future__ import annotations
 
-import os
 from typing import Callable, Optional, Tuple
 
 import mujoco
@@ -30,29 +30,21 @@ except ImportError as e:  # pragma: no cover - the optional extra
 from ..model.catalog import get_actuator
 from ..model.discretize import Payload
 from ..drives import make_drive
-from ..errors import MjeapError, ParameterError, check_integer, check_positive, check_range
+from ..errors import ParameterError, check_integer, check_positive, check_range
 from ..engines.loop import divergence_error, window_state
 from ..simulation.scene import Scene, diverged
+from .registration import register_envs
+from .rendering import MAX_IMAGE_SIZE, SceneRenderer, check_render_mode, render_modes
+from .system_env import float32_inside
 from .tracking import (VoltageLimiter, check_curvature_range, check_mass_range, default_reference, draw_episode, observe, step_lockstep, tracking_reward, warn_heavy_range)
 
 __all__ = ["CurvatureTrackingEnv", "ENV_ID"]
 
-#: the id under which importing this module registers :class:`CurvatureTrackingEnv`
+#: the id of :class:`CurvatureTrackingEnv` (:mod:`mjeap.envs.registration`)
 ENV_ID = "mjeap/CurvatureTracking-v0"
 #: MuJoCo's warnings of a state gone bad (with autoreset off the state is kept, not reset)
 BAD_STATE_WARNINGS = (mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN_BADQVEL,
                       mujoco.mjtWarning.mjWARN_BADQACC)
-MAX_IMAGE_SIZE = 4096
-
-
-def _float32_inside(lo: float, hi: float) -> Tuple[np.float32, np.float32]:
-    """float32 bounds inside [lo, hi]: a sampled action is never clipped by the float64 check."""
-    l32, h32 = np.float32(lo), np.float32(hi)
-    if l32 < lo:
-        l32 = np.nextafter(l32, np.float32(np.inf))
-    if h32 > hi:
-        h32 = np.nextafter(h32, np.float32(-np.inf))
-    return l32, h32
 
 
 class CurvatureTrackingEnv(gymnasium.Env):
@@ -83,7 +75,8 @@ class CurvatureTrackingEnv(gymnasium.Env):
     built, each refusal a :class:`~mjeap.ParameterError` naming the parameter and its range.
     """
 
-    metadata = {"render_modes": ["rgb_array"], "render_fps": None}   # render_fps: set per env, 1 / control step
+    #: the modes that work in this process (:func:`~mjeap.envs.rendering.render_modes`); render_fps: per env
+    metadata = {"render_modes": list(render_modes()), "render_fps": None}
 
     def __init__(self, actuator: str = "pedot-micro", reference: Optional[Callable[[float], float]] = None,
                  orientation: str = "up", payload: Optional[Payload] = Payload(12.6e-6, 6.27e-3),
@@ -93,8 +86,7 @@ class CurvatureTrackingEnv(gymnasium.Env):
                  reward_margin: float = 5.0, reward_fn: Optional[Callable[[float, float], float]] = None,
                  segments: int = 20, render_mode: Optional[str] = None, width: int = 480, height: int = 480):
         # -- parameters, before any work --------------------------------------------------
-        if render_mode is not None and render_mode not in self.metadata["render_modes"]:
-            raise ParameterError("render_mode", render_mode, "None or 'rgb_array'")
+        check_render_mode(render_mode)
         width = check_integer("width", width, 1, MAX_IMAGE_SIZE)
         height = check_integer("height", height, 1, MAX_IMAGE_SIZE)
         act = get_actuator(actuator)
@@ -132,16 +124,15 @@ class CurvatureTrackingEnv(gymnasium.Env):
         self._last_obs = self._observe()          # at rest; reset() draws an episode
 
         # -- spaces -------------------------------------------------------------------------
-        lo, hi = _float32_inside(*self.drive.voltage_range())
+        lo, hi = float32_inside(*([v] for v in self.drive.voltage_range()))
         self.action_space = spaces.Box(lo, hi, shape=(1,), dtype=np.float32)
         self.observation_space = spaces.Dict(
             {k: spaces.Box(-np.inf, np.inf, shape=v.shape, dtype=np.float64) for k, v in self._last_obs.items()})
 
         # -- rendering ----------------------------------------------------------------------
-        self.render_mode, self._renderer = render_mode, None
-        if render_mode == "rgb_array":
-            self._renderer = self._make_renderer(width, height)
-            self._camera = self._side_camera()
+        self.render_mode = render_mode
+        self._renderer = None if render_mode is None else \
+            SceneRenderer(render_mode, self.scene.model, self.scene.data, width, height, self._side_camera())
 
     # -- read-outs ---------------------------------------------------------------------
     @property
@@ -212,17 +203,6 @@ class CurvatureTrackingEnv(gymnasium.Env):
         return {k: v.copy() for k, v in obs.items()}
 
     # -- rendering ---------------------------------------------------------------------
-    def _make_renderer(self, width: int, height: int) -> mujoco.Renderer:
-        vis = self.scene.model.vis.global_
-        vis.offwidth, vis.offheight = max(vis.offwidth, width), max(vis.offheight, height)
-        try:
-            return mujoco.Renderer(self.scene.model, height, width)
-        except Exception as e:      # no GL backend (MUJOCO_GL=disable, no EGL/OSMesa library)
-            raise ParameterError("render_mode", "rgb_array",
-                                 "None here, or 'rgb_array' with an OpenGL backend: set MUJOCO_GL=egl or osmesa "
-                                 "before mujoco and mjeap are imported",
-                                 f"MUJOCO_GL={os.environ.get('MUJOCO_GL', '')!r}: {type(e).__name__}: {e}") from None
-
     def _side_camera(self) -> mujoco.MjvCamera:
         """A free camera on the hinge axis, looking at the bending plane (from above where
         the plane is horizontal), framing the model's extent."""
@@ -236,22 +216,15 @@ class CurvatureTrackingEnv(gymnasium.Env):
         return cam
 
     def render(self):
-        """An (height, width, 3) uint8 image of the beam now (``render_mode="rgb_array"``);
-        None without a render mode; refused after :meth:`close`."""
-        if self.render_mode is None:
-            return None
-        if self._renderer is None:
-            raise MjeapError("render() after close(): the renderer was released")
-        self._renderer.update_scene(self.scene.data, camera=self._camera)
-        return self._renderer.render()
+        """An (height, width, 3) uint8 image of the beam now (``render_mode="rgb_array"``;
+        ``"human"``: the viewer synchronised, None); None without a render mode; refused
+        after :meth:`close`."""
+        return None if self.render_mode is None else self._renderer.render()
 
     def close(self) -> None:
-        """Release the renderer (its GL context); safe to call twice."""
+        """Release the renderer (its GL context or window); safe to call twice."""
         if self._renderer is not None:
             self._renderer.close()
-            self._renderer = None
         super().close()
 
-
-if ENV_ID not in gymnasium.registry:      # a re-import (importlib.reload) would warn of a re-registration
-    gymnasium.register(id=ENV_ID, entry_point="mjeap.envs.gymnasium_env:CurvatureTrackingEnv")
+register_envs()         # mjeap's ids, where ``import mjeap`` has not (a second call changes nothing)

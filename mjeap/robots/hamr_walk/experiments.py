@@ -227,8 +227,10 @@ def trot_voltages(frequency: float, amplitude: float = AMPLITUDE, bias: float = 
     return out
 
 
-def _durations(frequency: float, settle: Optional[float], measure: Optional[float]) -> tuple:
-    """(settle, measure) in s, each whole cycles."""
+def trot_durations(frequency: float, settle: Optional[float], measure: Optional[float]) -> tuple:
+    """(settle, measure) in s of a trot at ``frequency`` (Hz), each whole cycles; None takes
+    :func:`walk`'s defaults (RAMP_CYCLES + SETTLE_CYCLES cycles and at least SETTLE s;
+    MEASURE_CYCLES cycles and at least MEASURE_MIN s)."""
     T = 1.0 / frequency
     s = settle if settle is not None else max((RAMP_CYCLES + SETTLE_CYCLES) * T, SETTLE)
     m = measure if measure is not None else max(MEASURE_CYCLES * T, MEASURE_MIN)
@@ -245,7 +247,7 @@ def walk(system: System, frequency: float, amplitude: float = AMPLITUDE, settle:
     deepest penetration, the chassis's and the legs' lowest points above the ground
     (:func:`clearances`); the rollout's result; the measuring window's start ``t0``."""
     bias = system.actuators[0].drive.params["bias"]
-    settle, measure = _durations(frequency, settle, measure)
+    settle, measure = trot_durations(frequency, settle, measure)
     fid = [mujoco.mj_name2id(system.model, mujoco.mjtObj.mjOBJ_GEOM, f"{leg}/foot") for leg in LEGS]
     sid = [mujoco.mj_name2id(system.model, mujoco.mjtObj.mjOBJ_SITE, f"{leg}/foot") for leg in LEGS]
     rows = {k: [] for k in ("body", "R", "feet", "feet_velocity", "contact", "penetration", "chassis_clearance",
