@@ -109,7 +109,6 @@ def test_system_recording_has_a_group_per_actuator_and_every_body(tmp_path):
     assert any(e.startswith("/world/bodies/ball/") for e in rec) and any(e.startswith("/world/bodies/world/") for e in rec)
 
 
-@pytest.mark.dm_control
 def test_environment_episode_recording_is_laid_out(tmp_path):
     from mjeap.envs.environment import make_environment, run_episode
     env = make_environment("pedot-micro", time_limit=0.2, seed=0)

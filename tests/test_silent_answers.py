@@ -153,7 +153,6 @@ def test_read_units_reads_its_own_field_only():
 
 
 # 6 ------------------------------------------------------------------------------------------
-@pytest.mark.dm_control
 def test_policy_with_two_values_for_one_actuator_is_refused():
     from mjeap.envs.environment import make_environment
     env = make_environment(time_limit=0.05, payload=None, orientation="horizontal")
