@@ -146,7 +146,7 @@ def test_trot_through_the_env_reaches_the_walkers_speed():
     from mjeap.robots.hamr_walk import build, walk, walk_metrics
     env = gymnasium.make("mjeap/HamrWalk-v0")
     got = run_trot(env, 10.0)
-    ref = walk_metrics(walk(build(), 10.0))
+    ref = walk_metrics(walk(build(d=leg_design()), 10.0))
     assert ref["upright"] and not got["ended"]
     assert got["speed_m_s"] == pytest.approx(ref["speed_m_s"], rel=0.10)
 

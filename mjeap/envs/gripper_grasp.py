@@ -28,6 +28,7 @@ import numpy as np
 from ..errors import check_range
 from ..robots.gripper.experiments import DROPPED, LIFT, LIFT_TIME
 from ..robots.gripper.model import build
+from .rendering import check_render_mode
 from .system_env import SystemEnv
 
 __all__ = ["GripperGraspEnv", "ENV_ID"]
@@ -40,6 +41,7 @@ class GripperGraspEnv(SystemEnv):
 
     def __init__(self, control_interval: float = 1e-2, lift_at: float = 1.0, hold: float = 0.5,
                  render_mode: Optional[str] = None, width: int = 480, height: int = 480):
+        check_render_mode(render_mode)          # before the robot is built
         self.lift_at = check_range("lift_at", lift_at, 0.0, 600.0, "s")
         self.hold = check_range("hold", hold, 0.0, 600.0, "s")
         system = build()

@@ -31,6 +31,7 @@ from ..errors import check_range
 from ..robots.hamr_leg.model import design
 from ..robots.hamr_walk.experiments import AMPLITUDE, trot_durations, trot_voltages
 from ..robots.hamr_walk.model import LEGS, MU, body_position, body_rotation, build, ground_rotation
+from .rendering import check_render_mode
 from .system_env import SystemEnv
 
 __all__ = ["HamrWalkEnv", "ENV_ID", "trot_policy", "run_trot", "leg_design"]
@@ -48,12 +49,16 @@ def leg_design() -> dict:
 
 
 class HamrWalkEnv(SystemEnv):
-    """HAMR-VI on a ground plane, walking under eight voltages (see the module text).
-    ``mu``: the feet's friction (0.51); ``segments``: per actuator (4)."""
+    """HAMR-VI on a ground plane, walking under eight voltages (see the module text):
+    ``control_interval`` and ``time_limit`` (s), the reward's ``speed_scale`` (m/s) and
+    ``upright_weight``, the roll-over's ``rollover_deg``; the walker's ``mu`` (the feet's
+    friction, 0.51) and ``segments`` per actuator (4); ``render_mode`` one of those that
+    work here (:mod:`mjeap.envs.rendering`), ``width`` and ``height`` in pixels."""
 
     def __init__(self, control_interval: float = 5e-4, time_limit: float = 1.0, speed_scale: float = SPEED_SCALE,
                  upright_weight: float = UPRIGHT_WEIGHT, rollover_deg: float = ROLLOVER_DEG, mu: float = MU,
                  segments: int = 4, render_mode: Optional[str] = None, width: int = 480, height: int = 480):
+        check_render_mode(render_mode)          # before the robot is built
         self.speed_scale = check_range("speed_scale", speed_scale, 1e-6, 10.0, "m/s")
         self.upright_weight = check_range("upright_weight", upright_weight, 0.0, 100.0)
         self.rollover_deg = check_range("rollover_deg", rollover_deg, 0.0, 180.0, "deg", lo_open=True)
@@ -79,6 +84,7 @@ class HamrWalkEnv(SystemEnv):
 
     @property
     def observation_names(self) -> list:
+        """The observation's entries, with their units."""
         return (["height_m", "qw", "qx", "qy", "qz", "vx_m_s", "vy_m_s", "vz_m_s", "wx_rad_s", "wy_rad_s", "wz_rad_s"]
                 + [f"{j}_rad" for j in self._joints] + [f"{j}_rad_s" for j in self._joints])
 
