@@ -47,6 +47,19 @@ def test_check_env_passes_with_its_defaults(env_id):
     assert [str(w.message) for w in caught if not any(a in str(w.message) for a in ADVICE)] == []
 
 
+def test_render_modes_follow_the_process(monkeypatch):
+    """No GL mode under MUJOCO_GL=disable (mjeap's default); no 'human' without a display on
+    Linux (the probe itself, uncached)."""
+    probe = render_modes.__wrapped__
+    monkeypatch.setenv("MUJOCO_GL", "disable")
+    assert probe() == ()
+    monkeypatch.setenv("MUJOCO_GL", "egl")
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    monkeypatch.setattr("sys.platform", "linux")
+    assert "human" not in probe()
+
+
 def _trajectory(env, actions, seed):
     """Observations and rewards of a seeded episode, and the most contacts seen at a step's end."""
     obs, _ = env.reset(seed=seed)
