@@ -20,8 +20,10 @@ ENVS = {
 def register_envs() -> list:
     """Register every id of :data:`ENVS` not yet in Gymnasium's registry (a second call, or a
     re-import, changes nothing); returns the ids registered now."""
-    import gymnasium
-    new = [i for i in ENVS if i not in gymnasium.registry]
+    # the registration module, not the package: as a plugin of Gymnasium 0.26-0.29 this runs
+    # while the package ``gymnasium`` is still being imported
+    from gymnasium.envs.registration import register, registry
+    new = [i for i in ENVS if i not in registry]
     for env_id in new:
-        gymnasium.register(id=env_id, entry_point=ENVS[env_id])
+        register(id=env_id, entry_point=ENVS[env_id])
     return new
