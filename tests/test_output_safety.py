@@ -87,7 +87,7 @@ def _leftovers(folder, keep):
 
 
 # ---------------------------------------------------------------- 1. SIGTERM takes Ctrl-C's path
-@pytest.mark.parametrize("kind", ["system", pytest.param("episode", marks=pytest.mark.dm_control), "scene"])
+@pytest.mark.parametrize("kind", ["system", "episode", "scene"])
 @pytest.mark.slow
 def test_sigterm_stops_every_stepping_loop_and_its_outputs_are_written(tmp_path, kind):
     rrd, csv_path = tmp_path / "r.rrd", (tmp_path / "r.csv" if kind == "scene" else None)

@@ -112,7 +112,6 @@ def test_passive_beam_in_a_host_without_actuation_and_gravity_changed_after_atta
 
 
 # 4 ------------------------------------------------------------------------------------------
-@pytest.mark.dm_control
 @pytest.mark.parametrize("bounds", [(-1e5, 1e5), (float("nan"), 1.0), (0.0, float("inf"))])
 def test_environment_initial_curvatures_within_rollouts_bounds(bounds):
     """(-1e5, 1e5) 1/m started episodes 60 turns round; NaN overflowed. rollout's bounds
