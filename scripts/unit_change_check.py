@@ -44,6 +44,8 @@ def conditioning(scene: Scene) -> dict:
             "max_joint_stiffness": float(stiff.max()) if stiff.size else 0.0,
             "max_dof_damping": float(damp.max()) if damp.size else 0.0,
             "timestep": float(m.opt.timestep), "gravity": float(np.linalg.norm(m.opt.gravity)),
+            # from a finite-difference stiffness (cable, rod): its rounding / eps differs per units
+            "rayleigh_beta_s": float(scene.choice.rayleigh_beta),
             "solver_tolerance": float(m.opt.tolerance)}
 
 
@@ -81,7 +83,8 @@ def main():
             sn, kn = run(aid, rep, NEW, engine, a.duration_scale)
             swing = float(np.ptp(ko))
             dev = float(np.max(np.abs(kn - ko)))
-            row = {"actuator": aid, "representation": rep, "engine": engine, "swing_1_m": swing,
+            beta_change = sn.choice.rayleigh_beta / so.choice.rayleigh_beta - 1
+            row = {"actuator": aid, "rayleigh_beta_relative_change": float(beta_change), "representation": rep, "engine": engine, "swing_1_m": swing,
                    "max_difference_1_m": dev, "difference_over_swing": dev / swing if swing else dev,
                    "old": conditioning(so), "new": conditioning(sn)}
             if row["difference_over_swing"] > BASELINE_ABOVE:
@@ -98,7 +101,8 @@ def main():
             base = row.get("rounding_baseline_over_swing")
             print(f"{aid:16s} {rep:6s} {engine:6s} swing {swing:.4g} 1/m, max diff/swing {row['difference_over_swing']:.3g}"
                   + ("" if base is None else f" (old units nudged by 1e-15: {base:.3g})")
-                  + ("" if conv is None else f" (solver converged: {conv:.3g})"), flush=True)
+                  + ("" if conv is None else f" (solver converged: {conv:.3g})")
+                  + (f" (Rayleigh beta moved {beta_change:.2g})" if beta_change else ""), flush=True)
     out = {"mujoco": MUJOCO_VERSION, "duration_scale": a.duration_scale, "runs": rows,
            "worst_difference_over_swing": max(r["difference_over_swing"] for r in rows)}
     if a.out:
