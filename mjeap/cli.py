@@ -516,8 +516,12 @@ def cmd_view(args) -> int:
     if why is not None:
         raise viewer.NoDisplayError(f"mjeap view needs a display: {why}. Write the model instead: "
                                     f"mjeap mjcf {args.name} -o FILE, or use mjeap.assets.path(NAME)")
+    from .robots import names as robot_names
     if args.name.lower().endswith(".xml"):
         vm = viewer.file_view_model(args.name, args.voltage)
+    elif args.name in robot_names():
+        from .robots import load
+        vm = viewer.system_view_model(load(args.name), f"robot {args.name}")
     else:
         from .units import REAL_TIME_UNITS
         vm = viewer.view_model(_scene_from_args(args, REAL_TIME_UNITS), args.drive, _params(args.param), args.voltage)

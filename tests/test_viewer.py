@@ -12,7 +12,7 @@ from mjeap.drives import make_drive
 from mjeap.errors import ParameterError
 from mjeap.model.fields import read_units
 from mjeap.simulation.viewer import (MAX_STEPS_PER_FRAME, NoDisplayError, display_reason, file_view_model, steps_due,
-                                     view, view_model)
+                                     system_view_model, view, view_model)
 from mjeap.units import REAL_TIME_UNITS
 
 
@@ -88,6 +88,20 @@ def test_a_drive_without_native_form_needs_a_waveform_and_is_stepped_by_mjeap():
 def test_file_view_model_reads_the_units_and_the_slider():
     vm = file_view_model(path("pzt-hamr-small"))
     assert vm.units.time == 1.0 and vm.voltage_range == tuple(vm.model.actuator("drive").ctrlrange)
+
+
+def test_a_robot_shows_its_actuators_voltages_on_sliders():
+    """robobee-wing: its actuator's ctrl is the drive voltage (V, the drive's range), stepped
+    by the System (what mjeap view ROBOT shows)."""
+    from mjeap.robots import load
+    wing = load("robobee-wing")
+    vm = system_view_model(wing, "robot robobee-wing")
+    drv = wing.actuators[0].drive
+    assert vm.voltage_range == tuple(float(x) for x in drv.voltage_range())
+    assert vm.units is wing.units and vm.timestep == wing.timestep
+    vm.data.ctrl[0] = drv.voltage_range()[1]
+    vm.advance(50)
+    assert vm.time == pytest.approx(50 * wing.timestep) and wing.time == vm.time
 
 
 def test_pacing_arithmetic():

@@ -4,7 +4,7 @@ What it shows is the driven model file (:mod:`mjeap.simulation.model_file`, in m
 the second): where the drive has a native form its voltage is the slider of actuator
 'drive' in the viewer's control panel (V, the drive's range); a waveform (``voltage``)
 plays through it instead, and drives without a native form play a waveform through mjeap's
-own drive, stepped in lockstep. The pacing keeps simulated time = wall time / slow motion
+own drive, stepped in lockstep; a System (a robot) shows one slider per actuator. The pacing keeps simulated time = wall time / slow motion
 (:func:`steps_due`); a 100 Hz piezo needs a slow motion of ~100 to be seen."""
 from __future__ import annotations
 
@@ -24,7 +24,8 @@ from ..model.fields import apply_dof_damping, load_mjcf, read_units
 from ..units import REAL_TIME_UNITS, UnitSystem
 from .model_file import DRIVE_ACTUATOR, model_file
 
-__all__ = ["NoDisplayError", "display_reason", "ViewModel", "view_model", "file_view_model", "steps_due", "view",
+__all__ = ["NoDisplayError", "display_reason", "ViewModel", "view_model", "file_view_model", "system_view_model",
+           "steps_due", "view",
            "MAX_STEPS_PER_FRAME"]
 
 #: the most steps between two frames: a slower machine falls behind (told at the end)
@@ -61,6 +62,7 @@ class ViewModel:
     voltage: Optional[Callable[[float], float]]
     drive: object
     note: str
+    stepper: Optional[Callable[[int], None]] = None     # steps n (a System's own step); None: mj_step
     timestep: float = field(init=False)     # s
 
     def __post_init__(self):
@@ -74,6 +76,9 @@ class ViewModel:
     def advance(self, nstep: int) -> None:
         """``nstep`` steps: the waveform's voltage (where one plays), then the step."""
         m, d = self.model, self.data
+        if self.stepper is not None:
+            self.stepper(nstep)
+            return
         for _ in range(nstep):
             if self.voltage is None:
                 mujoco.mj_step(m, d)
@@ -130,6 +135,17 @@ def file_view_model(path, voltage=None) -> ViewModel:
     return ViewModel(model, data, units, rng, None if voltage is None else waveform_function(voltage), None,
                      f"{path}" + ("" if rng is None else f"; voltage: slider '{DRIVE_ACTUATOR}', {rng[0]:g} to "
                                   f"{rng[1]:g} V"))
+
+
+def system_view_model(system, name: str = "system") -> ViewModel:
+    """The view of a :class:`mjeap.System` (a robot): every actuator's voltage (V) on its own
+    slider in the control panel (the actuators' ctrl), stepped by the system."""
+    m = system.model
+    sliders = ", ".join(f"'{m.actuator(i).name}' {m.actuator_ctrlrange[i, 0]:g} to {m.actuator_ctrlrange[i, 1]:g} V"
+                        for i in range(m.nu))
+    rng = None if m.nu == 0 else (float(m.actuator_ctrlrange[:, 0].min()), float(m.actuator_ctrlrange[:, 1].max()))
+    return ViewModel(m, system.data, system.units, rng, None, None, f"{name}; voltages: sliders {sliders}",
+                     stepper=system.step)
 
 
 def steps_due(sim_time: float, wall_elapsed: float, slow_motion: float, timestep: float,
