@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from pathlib import Path
 from typing import List, Optional
@@ -524,7 +525,12 @@ def cmd_view(args) -> int:
         vm = viewer.system_view_model(load(args.name), f"robot {args.name}")
     else:
         from .units import REAL_TIME_UNITS
-        vm = viewer.view_model(_scene_from_args(args, REAL_TIME_UNITS), args.drive, _params(args.param), args.voltage)
+        scene = _scene_from_args(args, REAL_TIME_UNITS)
+        vm = viewer.view_model(scene, args.drive, _params(args.param), args.voltage)
+        f1 = scene.choice.first_frequency
+        if f1 / args.slow_motion > 20:
+            print(f"mjeap view: the first mode is at {f1:.3g} Hz, too fast to follow at {args.slow_motion:g}x: "
+                  f"try --slow-motion {10 ** math.ceil(math.log10(f1 / 2)):g}", file=sys.stderr)
     print(f"mjeap view: {vm.note}; timestep {vm.timestep:.3g} s, {args.slow_motion:g}x slow motion", file=sys.stderr)
     out = viewer.view(vm, args.slow_motion)
     print(f"mjeap view: {out['simulated_s']:.4g} s simulated in {out['wall_s']:.4g} s"

@@ -128,3 +128,29 @@ def test_mjcf_command_writes_the_driven_model_in_volts_and_seconds(tmp_path):
     assert a.dynprm[0] * u.time == pytest.approx(1 / 1.8)
     body = out.read_text().split("-->\n", 1)[1]
     assert body == path("pedot-micro").read_text().split("-->\n", 1)[1]
+
+
+@pytest.mark.parametrize("argv,slider", [(["pzt-hamr-small", "--payload", "1mg@10mm"], (0.0, 200.0)),
+                                         (["robobee-wing"], (0.0, 200.0)),
+                                         (["pvdf-60", "--voltage", "step:700V"], None)])
+def test_view_command_builds_what_it_would_show(monkeypatch, capsys, argv, slider):
+    """The command up to the window (the window replaced): an actuator with its options, a
+    robot, a drive without native form with a waveform; the fast piezo gets the hint to
+    slow down."""
+    from mjeap.simulation import viewer
+    shown = {}
+
+    def fake_view(vm, slow_motion=1.0, duration=None):
+        shown["vm"], shown["slow"] = vm, slow_motion
+        vm.advance(3)
+        return {"simulated_s": vm.time, "wall_s": 0.0, "max_lag_s": 0.0}
+
+    monkeypatch.setattr(viewer, "display_reason", lambda *a, **k: None)
+    monkeypatch.setattr(viewer, "view", fake_view)
+    assert main(["view", *argv]) == 0
+    vm = shown["vm"]
+    assert vm.voltage_range == slider and vm.time > 0
+    err = capsys.readouterr().err
+    if argv[0] == "pzt-hamr-small":
+        assert "1mg" not in err and vm.model.body("payload").mass[0] == pytest.approx(1.0)   # 1 mg, internal
+        assert "try --slow-motion" in err
