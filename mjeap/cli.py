@@ -513,7 +513,7 @@ def cmd_optimize(args) -> int:
 def cmd_view(args) -> int:
     """MuJoCo's viewer on an actuator (catalog id or .toml file) or an MJCF file."""
     from .simulation import viewer
-    why = viewer.display_reason()                 # before any work
+    why = viewer.window_reason()                  # before any work
     if why is not None:
         raise viewer.NoDisplayError(f"mjeap view needs a display: {why}. Write the model instead: "
                                     f"mjeap mjcf {args.name} -o FILE, or use mjeap.assets.path(NAME)")
@@ -529,8 +529,9 @@ def cmd_view(args) -> int:
         vm = viewer.view_model(scene, args.drive, _params(args.param), args.voltage)
         f1 = scene.choice.first_frequency
         if f1 / args.slow_motion > 20:
-            print(f"mjeap view: the first mode is at {f1:.3g} Hz, too fast to follow at {args.slow_motion:g}x: "
-                  f"try --slow-motion {10 ** math.ceil(math.log10(f1 / 2)):g}", file=sys.stderr)
+            print(f"mjeap view: a period of the first bending mode ({f1:.3g} Hz) lasts {args.slow_motion / f1:.2g} s "
+                  f"on screen; --slow-motion {10 ** math.ceil(math.log10(f1 / 2)):g} shows it in ~0.5 s",
+                  file=sys.stderr)
     print(f"mjeap view: {vm.note}; timestep {vm.timestep:.3g} s, {args.slow_motion:g}x slow motion", file=sys.stderr)
     out = viewer.view(vm, args.slow_motion)
     print(f"mjeap view: {out['simulated_s']:.4g} s simulated in {out['wall_s']:.4g} s"

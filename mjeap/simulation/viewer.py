@@ -24,7 +24,7 @@ from ..model.fields import apply_dof_damping, load_mjcf, read_units
 from ..units import REAL_TIME_UNITS, UnitSystem
 from .model_file import DRIVE_ACTUATOR, model_file
 
-__all__ = ["NoDisplayError", "display_reason", "ViewModel", "view_model", "file_view_model", "system_view_model",
+__all__ = ["NoDisplayError", "display_reason", "window_reason", "ViewModel", "view_model", "file_view_model", "system_view_model",
            "steps_due", "view",
            "MAX_STEPS_PER_FRAME"]
 
@@ -38,13 +38,33 @@ class NoDisplayError(MjeapError, RuntimeError):
 
 
 def display_reason(environ=None, platform: str = sys.platform) -> Optional[str]:
-    """None where MuJoCo's viewer can open a window; else why not."""
+    """None where MuJoCo's viewer can open a window; else why not. The viewer opens its
+    window through GLFW whatever ``MUJOCO_GL`` says (that variable picks the off-screen
+    renderer's GL, and mjeap sets it to 'disable' where unset); on Linux it needs an X11 or
+    Wayland display."""
     env = os.environ if environ is None else environ
-    gl = env.get("MUJOCO_GL", "").lower()
-    if gl in ("disable", "disabled", "egl", "osmesa"):
-        return f"MUJOCO_GL={gl} (no on-screen GL); the viewer needs glfw on a display"
     if platform.startswith("linux") and not (env.get("DISPLAY") or env.get("WAYLAND_DISPLAY")):
-        return "no display: neither DISPLAY nor WAYLAND_DISPLAY is set"
+        return "no display: neither DISPLAY nor WAYLAND_DISPLAY is set (the viewer opens a GLFW window)"
+    return None
+
+
+def window_reason() -> Optional[str]:
+    """None where a viewer window opens here: a display (:func:`display_reason`) that GLFW
+    can initialise (tried, then let go); else why not."""
+    why = display_reason()
+    if why is not None:
+        return why
+    try:
+        import glfw
+    except ImportError as e:
+        return f"MuJoCo's viewer needs the glfw package ({e})"
+    import warnings
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        ok = glfw.init()
+    if not ok:
+        return "GLFW cannot open the display" + (f": {said[-1].message}" if said else "")
+    glfw.terminate()
     return None
 
 
@@ -161,7 +181,7 @@ def view(vm: ViewModel, slow_motion: float = 1.0, duration: Optional[float] = No
     until the window closes (or ``duration`` s of simulated time); refused first where no
     window can open. Returns the simulated and wall time and how far the pacing fell behind."""
     check_positive("slow_motion", slow_motion)
-    why = display_reason()
+    why = window_reason()
     if why is not None:
         raise NoDisplayError(f"mjeap view needs a display: {why}. The models it shows are files too: "
                              "mjeap mjcf NAME -o FILE, or mjeap.assets.path(NAME)")
