@@ -96,13 +96,15 @@ class ViewModel:
     def advance(self, nstep: int) -> None:
         """``nstep`` steps: the waveform's voltage (where one plays), then the step."""
         m, d = self.model, self.data
+        if nstep <= 0:
+            return
         if self.stepper is not None:
             self.stepper(nstep)
             return
+        if self.voltage is None:            # the slider's voltage, held: MuJoCo steps alone
+            mujoco.mj_step(m, d, nstep=nstep)
+            return
         for _ in range(nstep):
-            if self.voltage is None:
-                mujoco.mj_step(m, d)
-                continue
             v = float(self.voltage(self.time))
             if self.drive is None:
                 d.ctrl[0] = v
