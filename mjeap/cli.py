@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import sys
 from pathlib import Path
 from typing import List, Optional
@@ -10,7 +11,7 @@ from typing import List, Optional
 import numpy as np
 
 from .errors import ParameterError
-from .io.commandline import run_command
+from .io.commandline import arg_number, run_command
 
 
 def _fmt(v: float) -> str:
@@ -201,7 +202,7 @@ def material_record(m) -> dict:
                    "source": m.property(k).source} for k in PROPERTIES}}
 
 
-def _scene_from_args(args):
+def _scene_from_args(args, units=None):
     from .model.discretize import Payload
     from .simulation.scene import Scene
     payload = Payload.parse(args.payload) if args.payload else None
@@ -209,12 +210,16 @@ def _scene_from_args(args):
     return Scene(_actuator(args.name), representation=args.representation,
                  segments=DEFAULT_SEGMENTS if args.segments is None else args.segments,
                  orientation=args.orientation, payload=payload, timestep=args.timestep,
-                 integrator=args.integrator)
+                 integrator=args.integrator, units=units)
 
 
 def cmd_mjcf(args) -> int:
-    scene = _scene_from_args(args)
-    xml = scene.to_xml()
+    """The driven model file (mm, mg, s; actuator 'drive' in V where the drive compiles in)."""
+    from .simulation.model_file import model_file
+    from .units import REAL_TIME_UNITS
+    scene = _scene_from_args(args, REAL_TIME_UNITS)
+    f = model_file(scene)
+    xml = f"<!-- {scene.actuator.id}: {f.note} Units: {scene.units.describe()}. -->\n" + f.spec.to_xml()
     if args.output in (None, "-"):
         sys.stdout.write(xml)
     else:
@@ -505,6 +510,36 @@ def cmd_optimize(args) -> int:
     return 0 if r.success else 1
 
 
+def cmd_view(args) -> int:
+    """MuJoCo's viewer on an actuator (catalog id or .toml file) or an MJCF file."""
+    from .simulation import viewer
+    why = viewer.window_reason()                  # before any work
+    if why is not None:
+        raise viewer.NoDisplayError(f"mjeap view needs a display: {why}. Write the model instead: "
+                                    f"mjeap mjcf {args.name} -o FILE, or use mjeap.assets.path(NAME)")
+    from .robots import names as robot_names
+    if args.name.lower().endswith(".xml"):
+        vm = viewer.file_view_model(args.name, args.voltage)
+    elif args.name in robot_names():
+        from .robots import load
+        vm = viewer.system_view_model(load(args.name), f"robot {args.name}")
+    else:
+        from .units import REAL_TIME_UNITS
+        scene = _scene_from_args(args, REAL_TIME_UNITS)
+        vm = viewer.view_model(scene, args.drive, _params(args.param), args.voltage)
+        f1 = scene.choice.first_frequency
+        if f1 / args.slow_motion > 20:
+            print(f"mjeap view: a period of the first bending mode ({f1:.3g} Hz) lasts {args.slow_motion / f1:.2g} s "
+                  f"on screen; --slow-motion {10 ** math.ceil(math.log10(f1 / 2)):g} shows it in ~0.5 s",
+                  file=sys.stderr)
+    print(f"mjeap view: {vm.note}; timestep {vm.timestep:.3g} s, {args.slow_motion:g}x slow motion", file=sys.stderr)
+    out = viewer.view(vm, args.slow_motion)
+    print(f"mjeap view: {out['simulated_s']:.4g} s simulated in {out['wall_s']:.4g} s"
+          + (f", up to {out['max_lag_s']:.3g} s behind (raise --slow-motion)" if out["max_lag_s"] > 0.1 else ""),
+          file=sys.stderr)
+    return 0
+
+
 def cmd_robot(args) -> int:
     from .robots import get
     return get(args.name).main(args.options) or 0
@@ -522,10 +557,20 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("name", nargs="?", help="one material in full: each property's value, unit, range and source")
     p.add_argument("--json", action="store_true", help="every property with value, unit, range and source as JSON")
     p.set_defaults(func=cmd_materials)
-    p = sub.add_parser("mjcf", help="write the MJCF model of an actuator")
+    p = sub.add_parser("mjcf", help="write the driven MJCF model of an actuator (mm, mg, s; actuator 'drive' in V)")
     add_scene_args(p)
     p.add_argument("-o", "--output", help="output file (default: stdout)")
     p.set_defaults(func=cmd_mjcf)
+    p = sub.add_parser("view", help="MuJoCo's viewer on an actuator (or an MJCF file) in real time, the drive "
+                       "voltage on a slider")
+    add_scene_args(p)
+    p.add_argument("--slow-motion", type=arg_number(1e-3, 1e9), default=1.0,
+                   help="wall seconds per simulated second (default 1: real time; ~100 for a 100 Hz piezo)")
+    p.add_argument("--voltage", help="play a waveform instead of the slider (needed where the drive has no "
+                   "native form), e.g. square:1V@0.5Hz")
+    p.add_argument("--drive", help="drive name (default: the actuator's own)")
+    p.add_argument("--param", action="append", metavar="KEY=VALUE", help="drive parameter (repeatable)")
+    p.set_defaults(func=cmd_view)
     p = sub.add_parser("rollout", help="run an actuator with its drive and record it")
     add_scene_args(p)
     p.add_argument("--voltage", required=True,

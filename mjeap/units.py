@@ -12,6 +12,13 @@ from dataclasses import dataclass
 from .errors import check_positive
 
 
+#: the constraint solver's tolerance as an acceleration (m/s^2): MuJoCo's default 1e-8 in the
+#: (mm, mg, ms) units mjeap used first, so that a model in other units stops its solver at
+#: the same physical residual (the rod's edge equalities moved by 1e-5 of the swing in
+#: (mm, mg, s) with the bare 1e-8: scripts/unit_change_check.py)
+SOLVER_TOLERANCE = 1e-5
+
+
 @dataclass(frozen=True)
 class UnitSystem:
     """Internal units as their size in SI: ``length`` in m, ``mass`` in kg, ``time`` in s."""
@@ -67,6 +74,12 @@ class UnitSystem:
         """EI, N m^2."""
         return self.force * self.length**2
 
+    @property
+    def solver_tolerance(self) -> float:
+        """MuJoCo's ``opt.tolerance`` for :data:`SOLVER_TOLERANCE` (its solver stops on an
+        acceleration residual in internal units, so the number depends on the units)."""
+        return SOLVER_TOLERANCE / self.acceleration
+
     def describe(self) -> str:
         return f"length {self.length:g} m, mass {self.mass:g} kg, time {self.time:g} s"
 
@@ -74,3 +87,9 @@ class UnitSystem:
 #: Default internal units (mm, mg, ms): the PEDOT beam then has EI ~ 20, mass ~ 0.7,
 #: a timestep ~ 0.1 and gravity ~ 0.01; the piezo bimorphs stay within 1e-3..1e6.
 DEFAULT_UNITS = UnitSystem()
+
+#: The units of the shipped models (assets/mjcf, ``mjeap mjcf``, ``mjeap view``): mm and mg
+#: as :data:`DEFAULT_UNITS` (the same masses, inertias and lengths for MuJoCo's 1e-15 floor)
+#: and the second, so that MuJoCo's own viewer plays physical time. The same runs as in
+#: DEFAULT_UNITS within 3e-13 of the swing (hinge, cable and rod: scripts/unit_change_check.py).
+REAL_TIME_UNITS = UnitSystem(time=1.0)

@@ -1,11 +1,14 @@
-"""assets/mjcf is up to date, and every model compiles and stays at rest when unforced."""
+"""assets/mjcf is up to date, in seconds, found by mjeap.assets.path, and every model compiles,
+stays at rest when unforced and, driven in plain MuJoCo, moves as mjeap's run."""
 import mujoco
 import numpy as np
 import pytest
 
-from mjeap import DEFAULT_UNITS, get_actuator, load_mjcf
+from mjeap import get_actuator, load_mjcf
 from mjeap import Scene
-from mjeap.assets import ASSET_DIR, asset_name, asset_xml, iter_assets
+from mjeap.assets import ASSET_DIR, asset_name, asset_xml, iter_assets, path
+from mjeap.errors import ParameterError, UnknownNameError
+from mjeap.model.fields import read_units
 from mjeap.model.mjcf import arena_bytes
 
 ASSETS = list(iter_assets())
@@ -54,9 +57,10 @@ def test_asset_compiles_and_stays_at_rest_for_1s(actuator_id, representation):
     mujoco.mj_forward(m, d)
     tip = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, "tip")
     p0 = d.site_xpos[tip].copy()
-    mujoco.mj_step(m, d, nstep=int(round(1.0 / DEFAULT_UNITS.time / m.opt.timestep)))
+    u = read_units(m)
+    mujoco.mj_step(m, d, nstep=int(round(1.0 / u.time / m.opt.timestep)))
     assert d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number == 0
-    dx = (d.site_xpos[tip] - p0) * DEFAULT_UNITS.length  # clamp frame = world (horizontal)
+    dx = (d.site_xpos[tip] - p0) * u.length  # clamp frame = world (horizontal)
     L = act.length
     sag = in_plane_sag(act)
     if representation == "hinge":
@@ -115,3 +119,70 @@ def test_the_viewer_looks_at_the_bending_plane_with_a_light_and_a_floor_that_tou
     assert m.nlight >= 1
     floor = m.geom("floor")
     assert floor.type[0] == mujoco.mjtGeom.mjGEOM_PLANE and floor.contype[0] == 0 and floor.conaffinity[0] == 0
+
+
+def plain_units(m):
+    """(L, M, T) of the custom numeric 'mjeap_units', read with MuJoCo alone."""
+    i = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_NUMERIC, "mjeap_units")
+    assert i >= 0, "no mjeap_units"
+    return tuple(m.numeric_data[m.numeric_adr[i]:m.numeric_adr[i] + 3])
+
+
+@pytest.mark.parametrize("actuator_id,representation", ASSETS)
+def test_asset_is_in_seconds_and_found_by_path(actuator_id, representation):
+    """Every shipped file, opened in plain MuJoCo, declares the second as its time unit (so
+    MuJoCo's viewer plays physical time) and mm, mg; mjeap.assets.path finds it."""
+    p = path(actuator_id, representation)
+    assert p == ASSET_DIR / asset_name(actuator_id, representation)
+    m = mujoco.MjModel.from_xml_path(str(p))
+    assert plain_units(m) == (1e-3, 1e-6, 1.0)
+
+
+def test_path_refuses_unknown_names():
+    with pytest.raises(UnknownNameError):
+        path("pedot-mikro")
+    with pytest.raises(ParameterError, match="representation"):
+        path("pzt-robobee", "rod")          # tapered: no rod file
+
+
+DRIVEN = [(a, r) for a, r in ASSETS if r == "hinge" and not a.startswith("pvdf")]
+
+
+def plain_step_response(m, steps=400, every=10):
+    """Tip curvature (1/m, arc through clamp and tip) every ``every`` steps of a step of the
+    drive to 3/4 of its range from rest, stepped with MuJoCo alone."""
+    L = plain_units(m)[0]
+    a = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, "drive")
+    assert a >= 0
+    lo, hi = m.actuator_ctrlrange[a]
+    d = mujoco.MjData(m)
+    rest = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_KEY, "rest")
+    if rest >= 0:
+        mujoco.mj_resetDataKeyframe(m, d, rest)
+    d.ctrl[a] = 0.75 * hi + 0.25 * lo
+    clamp, tip, kappa = m.body("clamp").id, m.site("tip").id, []
+    for _ in range(steps // every):
+        mujoco.mj_step(m, d, nstep=every)
+        R = d.xmat[clamp].reshape(3, 3)
+        x, y, _ = R.T @ (d.site_xpos[tip] - d.xpos[clamp]) * L
+        kappa.append(2 * y / (x * x + y * y))
+    return np.array(kappa)
+
+
+@pytest.mark.parametrize("actuator_id,representation", DRIVEN)
+def test_driven_asset_in_plain_mujoco_moves_as_mjeaps_model(actuator_id, representation):
+    """The files with their drive compiled in (actuator 'drive', ctrl in V), in seconds: a
+    step of the drive from rest, 400 steps in plain MuJoCo, against the same driven model
+    built by mjeap in its default units (mm, mg, ms) and read back from its MJCF text (as
+    the file was): the tip curvature within 1e-9 of the swing, so the unit change moved
+    nothing beyond float rounding (scripts/unit_change_check.py: every engine and
+    representation); and the file's timestep is the scene's."""
+    from mjeap.simulation.model_file import model_file
+    m = mujoco.MjModel.from_xml_path(str(path(actuator_id, representation)))
+    s = Scene(actuator_id, representation=representation)
+    assert s.units.time == 1e-3
+    ms = mujoco.MjModel.from_xml_string(model_file(s).spec.to_xml())
+    assert m.opt.timestep * plain_units(m)[2] == pytest.approx(s.timestep, rel=1e-12)
+    kappa, ref = plain_step_response(m), plain_step_response(ms)
+    assert np.ptp(ref) > 0.1 * np.abs(ref).max() > 0
+    assert np.max(np.abs(kappa - ref)) <= 1e-9 * np.ptp(ref)

@@ -260,13 +260,17 @@ def test_no_test_imports_a_script_by_path():
 
 
 def test_only_mjeap_is_installed_at_the_top():
-    """Every package is a folder of mjeap/ (no package-dir mapping, no top-level folder
-    installed under another name)."""
+    """Every package of code is a folder of mjeap/; the one package-dir mapping installs
+    data, not code: the model files of assets/mjcf as mjeap.mjcf_files (mjeap.assets.path),
+    no Python module in it."""
     cfg = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
     assert all(p == "mjeap" or p.startswith("mjeap.") for p in cfg["packages"])
-    assert not cfg.get("package-dir")
+    data = cfg.get("package-dir", {})
+    assert data == {"mjeap.mjcf_files": "assets/mjcf"}
+    assert not list((ROOT / "assets" / "mjcf").glob("*.py"))
+    assert cfg["package-data"]["mjeap.mjcf_files"] == ["*.xml"]
     on_disk = {m for m, p in MODULES.items() if p.name == "__init__.py"}
-    assert on_disk == set(cfg["packages"]), on_disk ^ set(cfg["packages"])
+    assert on_disk == set(cfg["packages"]) - set(data), on_disk ^ (set(cfg["packages"]) - set(data))
     assert not (ROOT / "controllers").exists()
 
 

@@ -91,7 +91,7 @@ def test_native_batch_on_two_threads_equals_one_by_one():
 def test_generated_models_carry_units_and_the_drive():
     m = mujoco.MjModel.from_xml_path(str(ASSET_DIR / "pedot-micro_hinge.xml"))
     u = read_units(m)
-    assert (u.length, u.mass, u.time) == (1e-3, 1e-6, 1e-3)
+    assert (u.length, u.mass, u.time) == (1e-3, 1e-6, 1.0)        # seconds: the viewer's real time
     a = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, "drive")
     assert a >= 0 and tuple(m.actuator_ctrlrange[a]) == (-3.0, 3.0)
     assert m.actuator_dyntype[a] == mujoco.mjtDyn.mjDYN_FILTEREXACT

@@ -398,7 +398,7 @@ def build_spec(layout: BeamLayout, representation: str = "hinge", orientation: s
     name = model_name or f"{layout.actuator_id}-{representation}-{orientation}"
     xml = f"""<mujoco model="{name}">
   <compiler angle="radian" autolimits="true"/>
-  <option gravity="0 0 {-g:.12g}"><flag contact="disable"/></option>
+  <option gravity="0 0 {-g:.12g}" tolerance="{units.solver_tolerance:.12g}"><flag contact="disable"/></option>
   <visual><global elevation="-20"/></visual>
   <statistic center="{0.5 * L * R[0, 0]:.6g} {0.5 * L * R[1, 0]:.6g} {0.5 * L * R[2, 0]:.6g}" extent="{1.5 * L:.6g}"/>
   {builder.extensions_xml()}
