@@ -2,7 +2,9 @@
 reference: the same native model, MuJoCo Warp in float32 against MuJoCo in float64.
 
 Tolerance: 1e-3 of the tip-curvature swing (float32 round-off over the run; measured
-4.2e-6 over 294 steps). Skipped only where mujoco-warp is not installed (the ``warp``
+1.2e-6 over 2204 steps). The 1.5 s pass step 1215, where MuJoCo Warp's own step went NaN on
+this scene (its solver's float32 factor of the mass matrix alone; the engine steps without
+the solver where no constraint row can arise, mjeap.engines.warp). Skipped only where mujoco-warp is not installed (the ``warp``
 extra; CI installs it); the kernels compile once into Warp's kernel cache
 (``WARP_CACHE_PATH``, ~50 s on 2 cores), later runs load them."""
 from importlib.util import find_spec
@@ -23,7 +25,7 @@ def needs_warp():
 #: square 0.1 Hz from the measured initial curvature; 16 amplitudes as a map's axis
 SCENE = {"orientation": "up", "payload": "12.6mg@6.27mm"}
 AMPLITUDES = np.linspace(0.25, 1.5, 16)
-DURATION, K0 = 0.6, -303.0
+DURATION, K0 = 1.5, -303.0
 
 
 @pytest.mark.slow
@@ -39,7 +41,7 @@ def test_warp_batch_follows_the_native_engine():
     for a, b in zip(ref, got):
         np.testing.assert_array_equal(a.time, b.time)
         swing = np.ptp(a.tip_curvature)
-        assert swing > 10.0                 # 1/m: the runs move (19 to 33 1/m after 0.2 s)
+        assert swing > 20.0                 # 1/m: the runs move (up to 165 1/m over 1.5 s)
         dev = np.max(np.abs(a.tip_curvature - b.tip_curvature))
         worst = max(worst, dev / swing)
         assert dev <= 1e-3 * swing

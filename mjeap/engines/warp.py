@@ -7,11 +7,15 @@ way: the sampled states go back into the native model's MjData (``mj_setState`` 
 ``mj_kinematics``) and the drive's native read-outs, so the results are the native engine's
 to float32 round-off. Optional: ``pip install -e ".[warp]"`` (mujoco-warp, warp-lang).
 
-Settings of the model on the Warp path only (the result's ``meta['warp']`` lists them):
+On the Warp path only (the result's ``meta['warp']`` says both):
 
 * ``mjDSBL_AUTORESET`` cleared: mjeap sets it so that MuJoCo never resets a diverging run
   behind its back; MuJoCo Warp has no automatic reset at all (it refuses the flag), so
   clearing it changes nothing: a diverging run is caught at its samples here.
+* where the model can make no constraint row (contact disabled, no equality, limit or
+  friction loss: every beam scene), the implicit step goes without the constraint solver
+  (:func:`_smooth_step`): its factor of the mass matrix alone goes NaN in float32 on seed
+  000's standing beam with its payload (condition number 4.7e7), the step itself does not.
 
 Refused before any work, with the reason in words: a controller (the voltages are the
 batch's, fixed before the run), a drive stepped from Python (no native form), the rod's
@@ -41,6 +45,9 @@ __all__ = ["WarpEngine", "warp_reason", "CLEARED"]
 #: what the Warp path clears in the model, and why (the result's meta['warp']['cleared'])
 CLEARED = {"mjDSBL_AUTORESET": "MuJoCo Warp has no automatic reset (it refuses the flag); mjeap sets it only to "
                                "keep MuJoCo from resetting a diverging run, which Warp never does"}
+#: how the steps went where no constraint row can arise (meta['warp']['step'])
+SMOOTH_STEP = ("mujoco_warp's implicit step without its constraint solver: the model makes no constraint rows, and "
+               "the solver's factor of the mass matrix alone fails in float32 on a standing beam with a payload")
 INSTALL = 'mujoco-warp is not installed (pip install -e ".[warp]")'
 
 
@@ -97,6 +104,40 @@ def warp_reason(scene, drive, controller=None) -> Optional[str]:
     return None
 
 
+def _constraint_rows(m) -> list:
+    """What can make constraint rows in the native model ``m`` (contacts, equalities, joint
+    and tendon limits, friction loss): none in a beam scene with contact disabled."""
+    D = mujoco.mjtDisableBit
+    sources = {"contacts": not (m.opt.disableflags & D.mjDSBL_CONTACT) and m.ngeom > 0,
+               "equality constraints": m.neq > 0, "joint limits": bool(np.any(m.jnt_limited)),
+               "tendon limits": bool(np.any(m.tendon_limited)),
+               "friction loss": bool(np.any(m.dof_frictionloss) or np.any(m.tendon_frictionloss))}
+    return [k for k, v in sources.items() if v]
+
+
+#: the integrators whose step :func:`_smooth_step` takes
+IMPLICIT = (mujoco.mjtIntegrator.mjINT_IMPLICITFAST, mujoco.mjtIntegrator.mjINT_IMPLICIT)
+
+
+def _smooth_step(m, d) -> None:
+    """MuJoCo Warp's implicit(fast) step of a model that makes no constraint rows, without its
+    constraint solver: position, velocity, actuation, the smooth forces, then the implicit
+    update with the smooth forces as its right-hand side (M qacc = qfrc_smooth exactly, no
+    constraint force). Why: with no rows the Newton solver still factors the mass matrix
+    alone, whose condition number reaches 4.7e7 on seed 000's standing beam with its
+    12.6 mg payload (363 links' masses), beyond float32 (1 / eps = 1.7e7): the factor went
+    NaN at step 1215 of the 1.333 V run. The implicit update factors M + h D (condition
+    ~100 there) and never needs M alone. Sensors are not evaluated (none is read back)."""
+    import warp as wp
+    import mujoco_warp as mjw
+    mjw.fwd_position(m, d, factorize=False)
+    mjw.fwd_velocity(m, d)
+    mjw.fwd_actuation(m, d)
+    mjw.fwd_acceleration(m, d)
+    wp.copy(d.efc.Ma, d.qfrc_smooth)
+    mjw.implicit(m, d)
+
+
 def _state_reason(m) -> Optional[str]:
     """None where the full-physics state of the native model ``m`` is time, qpos, qvel and
     act only (what Warp's data carries back); else what else it holds."""
@@ -126,6 +167,11 @@ class _Worlds:
                                  f"MuJoCo Warp refuses the native model: {e}") from e
         self.ctrl = wp.zeros((1, B, m.nu), dtype=float)
         self.graphs = {}
+        #: MuJoCo Warp's step, or where nothing can make a constraint row, the same step without
+        #: the constraint solver (:func:`_smooth_step`)
+        self.smooth = (not _constraint_rows(m) and m.opt.integrator in IMPLICIT
+                       and self.data.efc.Ma.shape == self.data.qfrc_smooth.shape)
+        self.step = _smooth_step if self.smooth else mjw.step
         self.device = str(wp.get_device())
 
     def _graph(self, L: int):
@@ -136,11 +182,11 @@ class _Worlds:
                 self.ctrl = wp.zeros((L, self.B, self.m.nu), dtype=float)
                 self.graphs.clear()
             if not self.graphs:         # compile (or load) every kernel before the first capture
-                mjw.step(self.model, self.mjw.put_data(self.m, mujoco.MjData(self.m), nworld=1))
+                self.step(self.model, self.mjw.put_data(self.m, mujoco.MjData(self.m), nworld=1))
             with wp.ScopedCapture() as cap:
                 for i in range(L):
                     wp.copy(self.data.ctrl, self.ctrl[i])
-                    mjw.step(self.model, self.data)
+                    self.step(self.model, self.data)
             self.graphs[L] = cap.graph
         return self.graphs[L]
 
@@ -207,7 +253,8 @@ def _roller(native, meta: Optional[dict]):
         B = len(state0)
         w = _worlds(native, B)
         if meta is not None:
-            meta["warp"] = {"device": w.device, "float": "float32", "cleared": dict(CLEARED), "worlds": B}
+            meta["warp"] = {"device": w.device, "float": "float32", "cleared": dict(CLEARED), "worlds": B,
+                            "step": SMOOTH_STEP if w.smooth else "mujoco_warp.step"}
         nu = model.nu
         loads = None
         if control_spec & mujoco.mjtState.mjSTATE_XFRC_APPLIED:
