@@ -36,7 +36,9 @@ from typing import Optional
 import mujoco
 import numpy as np
 
+from ..errors import ParameterError
 from .base import CONTROLLER_REASON, Engine
+from .frame import Decided
 from .native import run_native, why_not as native_why_not
 from .threaded import MAXVAL, STATE
 
@@ -152,7 +154,6 @@ class _Worlds:
     buffer and the step graphs by their length; kept on the native model per batch size."""
 
     def __init__(self, m, B: int):
-        from ..errors import ParameterError
         wp, mjw = _warp()
         self.wp, self.mjw, self.m, self.B = wp, mjw, m, B
         mm = copy.copy(m)       # the native engine's model is left as it is
@@ -290,7 +291,11 @@ def _roller(native, meta: Optional[dict]):
             if bad is not None:
                 return None, bad, None
             for b in range(B):
-                take(b, k, state[b], before[b])
+                try:
+                    take(b, k, state[b], before[b])
+                except Decided as stop:     # the run ends here (Samples.stop): its state goes with it
+                    stop.step, stop.state, stop.before = k, np.array(state[b]), np.array(before[b])
+                    raise
         if done < n:
             before = advance(n - 1) if n - done > 1 else (state if done else state0)
             state = advance(n)
@@ -315,7 +320,6 @@ class WarpEngine(Engine):
 
     def run(self, scene, drives, v_steps, initial_curvatures, sample_steps, samples, *, nthread=0, progress=None,
             check_every=100, controller=None, meta=None) -> None:
-        from ..errors import ParameterError
         native = scene.native_model(drives[0])
         why = _state_reason(native.model)
         if why is not None:
