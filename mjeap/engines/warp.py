@@ -127,7 +127,7 @@ def _smooth_step(m, d) -> None:
     update with the smooth forces as its right-hand side (M qacc = qfrc_smooth exactly, no
     constraint force). Why: with no rows the Newton solver still factors the mass matrix
     alone, whose condition number reaches 4.7e7 on seed 000's standing beam with its
-    12.6 mg payload (363 links' masses), beyond float32 (1 / eps = 1.7e7): the factor went
+    12.6 mg payload (363 times a link's mass), beyond float32 (1 / eps = 1.7e7): the factor went
     NaN at step 1215 of the 1.333 V run. The implicit update factors M + h D (condition
     ~100 there) and never needs M alone. Sensors are not evaluated (none is read back)."""
     import warp as wp
@@ -213,15 +213,13 @@ class _Worlds:
             out[:, 1 + nq + nv:1 + nq + nv + na] = d.act.numpy()
         return out
 
-    def steps(self, ctrl: np.ndarray, loads: Optional[np.ndarray] = None) -> None:
+    def steps(self, ctrl: np.ndarray) -> None:
         """Step all worlds ``ctrl.shape[1]`` times, world b's ctrl of step i ``ctrl[b, i]``."""
         L = ctrl.shape[1]
         if L == 0:
             return
         graph = self._graph(L)
         self.ctrl[:L].assign(np.ascontiguousarray(np.swapaxes(ctrl, 0, 1), dtype=np.float32))
-        if loads is not None:
-            self.data.xfrc_applied.assign(loads.astype(np.float32))
         self.wp.capture_launch(graph)
 
 
