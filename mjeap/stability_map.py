@@ -13,6 +13,7 @@ from .io.commandline import arg_integer, arg_output, parse_args
 from .io.outputs import replacing
 from .io.recording import rrd_file
 from .analysis.stability import MAP_BASE, column_limits, simulated_edges
+from .engines import ENGINES
 from .sweep import EXECUTORS, grid, read_results, run_sweep
 
 __all__ = ["main"]
@@ -28,6 +29,8 @@ def main(argv=None):
                     help="folder of results.csv, stability_map.png, report.md and stability_map.rrd")
     ap.add_argument("--workers", type=arg_integer(1), default=2)
     ap.add_argument("--executor", default="processes", choices=EXECUTORS)
+    ap.add_argument("--engine", default="auto", choices=ENGINES,
+                    help="the engine every point runs on (warp: MuJoCo Warp, the optional 'warp' extra)")
     ap.add_argument("--masses", type=arg_integer(2, 1000), default=11,
                     help="payload masses from 0 to 150 mg, 0 left out (2 to 1000)")
     ap.add_argument("--amplitudes", type=arg_integer(1, 1000), default=6,
@@ -52,7 +55,7 @@ def main(argv=None):
     points = grid(payload_mass=[float(m) for m in masses], amplitude=[float(v) for v in amps])
     metrics = ("returns", "peak_to_peak", "max_stress_proxy") + (("estimated_error",) if a.accuracy else ()) + \
         (("stopped_early",) if a.stop_when_periodic else ())
-    base = {**MAP_BASE, "duration": a.periods * (1.0 / MAP_BASE["frequency"]), **({"accuracy": a.accuracy} if a.accuracy else {}),
+    base = {**MAP_BASE, "engine": a.engine, "duration": a.periods * (1.0 / MAP_BASE["frequency"]), **({"accuracy": a.accuracy} if a.accuracy else {}),
             **({"stop_when_periodic": a.stop_when_periodic} if a.stop_when_periodic else {})}
     s = run_sweep(points, out / "results.csv", metrics=metrics, base=base,
                   executor=a.executor, workers=a.workers)

@@ -15,7 +15,7 @@ LAYER_FILES = {
               "test_rod", "test_assets", "test_actuator_files"),
     "drives": ("test_drive_ionic", "test_drive_electrostatic", "test_drive_allocation", "test_piezo_moment",
                "test_piezo_power", "test_pvdf_fidelity"),
-    "engines": ("test_threaded", "test_native"),
+    "engines": ("test_threaded", "test_native", "test_warp"),
     "simulation": ("test_rollout", "test_system", "test_accuracy", "test_periodic", "test_golden",
                    "test_viewer"),
     "analysis": ("test_identify", "test_self_sensing", "test_stability_map"),

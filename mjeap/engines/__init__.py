@@ -12,7 +12,9 @@ environments through :func:`stepper`. Registered here:
 * ``threaded``: an open-loop drive's moment history computed up front, applied by
   ``mujoco.rollout`` (:mod:`mjeap.engines.threaded`);
 * ``loop``: the drive, then ``mj_step``, once per step from Python; serves every drive and
-  closed-loop controllers (:mod:`mjeap.engines.loop`).
+  closed-loop controllers (:mod:`mjeap.engines.loop`);
+* ``warp``: the native engine's model on MuJoCo Warp, float32 batches (:mod:`mjeap.engines.warp`,
+  the optional ``warp`` extra); ``auto`` never reaches it (native applies wherever it does).
 
 ``auto`` takes the first that applies in that order. A new engine (a batched GPU one, say)
 is one module that calls :func:`register_engine`.
@@ -200,10 +202,11 @@ def stepper(name: str = "loop") -> Engine:
     return get_engine(name)
 
 
-from . import native as _native, threaded as _threaded, loop as _loop  # noqa: E402  registration order = auto's
+from . import native as _native, threaded as _threaded, loop as _loop, warp as _warp  # noqa: E402  auto's order
 
 register_engine(_native.NativeEngine())
 register_engine(_threaded.ThreadedEngine())
 register_engine(_loop.LoopEngine())
+register_engine(_warp.WarpEngine())
 #: the engine names a run accepts
 ENGINES = ("auto", *engine_names())

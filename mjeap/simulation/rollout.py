@@ -254,11 +254,12 @@ def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable
     part = eng.part(scene, drives[0])
     samples = [Samples(part, len(steps)) for _ in voltages]
     wall0 = _time.perf_counter()
-    run_checked(eng, scene, drives, v_steps, list(kappa0), steps, samples, nthread=nthread)
+    engine_meta: dict = {}              # what the engine says of its run (the warp engine's settings)
+    run_checked(eng, scene, drives, v_steps, list(kappa0), steps, samples, nthread=nthread, meta=engine_meta)
     wall = _time.perf_counter() - wall0
     out = []
     for w, d, k0, smp in zip(waves, drives, kappa0, samples):
         meta = _meta(scene, d, w, duration, float(k0), len(v_steps[0]), eng.name)
-        meta.update(wall_time_s=wall, batch=len(voltages), nthread=nthread)
+        meta.update(engine_meta, wall_time_s=wall, batch=len(voltages), nthread=nthread)
         out.append(smp.result(d, float(k0), meta))
     return out
