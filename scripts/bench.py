@@ -526,7 +526,7 @@ def bench_accuracy(claim_cases=12):
     return out
 
 
-def bench_metric_map(masses=6, amplitudes=(0.5, 1.0, 1.5), rounds=2):
+def bench_metric_map(masses=(20, 40, 60, 70, 74, 78, 82, 100), amplitudes=(0.25, 1.0, 1.5), rounds=2):
     """The stability map (pedot-micro standing, 30 s points) at accuracy 1e-2 on its metrics
     (returns, peak_to_peak: mjeap.simulation.metric_accuracy, relaxed steps) against the
     default model on the same points, serial and on 2 workers, interleaved in ``rounds``
@@ -536,9 +536,10 @@ def bench_metric_map(masses=6, amplitudes=(0.5, 1.0, 1.5), rounds=2):
     import tempfile
     from mjeap.analysis.stability import MAP_BASE, simulated_edges
     from mjeap.sweep import grid, read_results, run_sweep
-    pts = grid(payload_mass=list(np.linspace(20e-6, 120e-6, masses)) + [76e-6, 78e-6], amplitude=list(amplitudes))
-    out = {"case": f"stability map points ({len(pts)}: masses x amplitudes, 76 and 78 mg at the relaxed column "
-                   "load among them), pedot-micro standing, 30 s, square 0.1 Hz", "rounds": rounds}
+    pts = grid(payload_mass=[m * 1e-6 for m in masses], amplitude=list(amplitudes))
+    out = {"case": f"stability map points ({len(pts)}: {', '.join(map(str, masses))} mg x {amplitudes} V; the "
+                   "relaxed column load 76 mg between 74 and 78), pedot-micro standing, 30 s, square 0.1 Hz",
+           "rounds": rounds}
     walls = {}
     rows = {}
     with tempfile.TemporaryDirectory() as d:

@@ -208,7 +208,8 @@ def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable
                   drive: Optional[str] = None, drive_params: Optional[dict] = None,
                   initial_curvatures: Union[float, Sequence[float]] = 0.0,
                   sample_interval: Optional[float] = None, nthread: Optional[int] = None,
-                  engine: str = "auto", accuracy: Optional[float] = None) -> List[RolloutResult]:
+                  engine: str = "auto", accuracy: Optional[float] = None,
+                  metrics: Optional[Sequence[str]] = None) -> List[RolloutResult]:
     """Many rollouts of one scene, one per entry of ``voltages`` (and of
     ``initial_curvatures``, 1/m, a scalar for all; a single waveform runs once per initial
     curvature, or once), on MuJoCo's threaded rollout with ``nthread`` threads (1 to the
@@ -219,7 +220,8 @@ def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable
     scene's own): one model is chosen for the whole batch, from the pilots of its first
     member and then for its worst member (:mod:`mjeap.simulation.accuracy`: each member's
     error is measured on it, segments and step), and each result carries its own estimated
-    error."""
+    error. ``metrics`` (with a target): the target is on these metrics of each member, each
+    member choosing its own model as :func:`rollout` does (one by one)."""
     from ..drives import make_drive
     duration = check_positive("duration", duration, "s")
     if np.ndim(initial_curvatures) == 0:
@@ -242,6 +244,13 @@ def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable
                              f"one number (1/m) for all or one per voltage ({len(voltages)})")
     kappa0 = [check_initial_curvature(k, scene.layout.length, "initial_curvatures") for k in kappa0]
     target = target_for(scene, accuracy)
+    if metrics is not None:
+        from .metric_accuracy import check_metrics
+        metrics = check_metrics(metrics)
+    if target is not None and metrics is not None:       # each member's own model for its answer
+        return [rollout(scene, v, duration, drive=drive, drive_params=drive_params, initial_curvature=k,
+                        sample_interval=sample_interval, progress=False, engine=engine, accuracy=target,
+                        metrics=metrics) for v, k in zip(voltages, kappa0)]
     if target is not None:
         from .accuracy import run_at_accuracy
         scene.part.check_derivable()
