@@ -104,3 +104,14 @@ def test_batch_members_each_answer_their_metrics():
     assert len(rs) == 2
     for r in rs:
         assert r.meta["accuracy"]["metrics"]["peak_to_peak"]["estimated_error"] <= 5e-2
+
+
+def test_sweep_cli_takes_accuracy_once(capsys, tmp_path):
+    """`mjeap sweep --accuracy` is `--set accuracy=`: both at once, or out of range, refused before any point."""
+    from mjeap.cli import main
+    args = ["sweep", "--vary", "payload_mass=1e-6", "--out", str(tmp_path / "s.csv"), "--executor", "serial"]
+    assert main(args + ["--accuracy", "1e-2", "--set", "accuracy=1e-2"]) != 0
+    assert "--accuracy" in capsys.readouterr().err
+    assert main(args + ["--accuracy", "2"]) != 0
+    assert "accuracy" in capsys.readouterr().err
+    assert not (tmp_path / "s.csv").exists()
