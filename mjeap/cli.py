@@ -465,6 +465,11 @@ def cmd_sweep(args) -> int:
     points = sweep.random_design(args.random, args.seed, **values) if args.random is not None else \
         sweep.grid(**values)
     base = {k: to_value(k, v, actuator) for k, v in raw.items()}
+    if args.accuracy is not None:
+        from .simulation.accuracy import check_accuracy
+        if "accuracy" in raw:
+            raise ParameterError("--accuracy", args.accuracy, "either --accuracy or --set accuracy=..., not both")
+        base["accuracy"] = check_accuracy(args.accuracy)
     try:
         record = [int(i) for i in args.record.split(",")] if args.record else []
     except ValueError:
@@ -613,6 +618,10 @@ def build_parser() -> argparse.ArgumentParser:
                         "point parameter (actuator, payload_mass, amplitude, frequency, segments, ...), drive.NAME or "
                         "actuator.NAME (actuator.length, actuator.layers.LAYER.thickness, ...; repeatable)")
     p.add_argument("--set", action="append", metavar="NAME=VALUE", help="fixed parameter for every point (repeatable)")
+    p.add_argument("--accuracy", type=float, default=None,
+                   help="error target of every point's metrics (1e-5 to 0.2, as --set accuracy=...): on "
+                        "peak_to_peak, returns, ... each relative to its scale, estimates in estimated_error.METRIC "
+                        "columns (docs/concepts/accuracy.md)")
     p.add_argument("--random", type=int, metavar="N", help="N random points instead of the full grid")
     p.add_argument("--seed", type=int, default=0, help="seed of the random design")
     p.add_argument("--metrics", default="peak_to_peak,returns",

@@ -526,6 +526,63 @@ def bench_accuracy(claim_cases=12):
     return out
 
 
+def bench_metric_map(masses=(20, 40, 60, 70, 74, 78, 82, 100), amplitudes=(0.25, 1.0, 1.5), rounds=2):
+    """The stability map (pedot-micro standing, 30 s points) at accuracy 1e-2 on its metrics
+    (returns, peak_to_peak: mjeap.simulation.metric_accuracy, relaxed steps) against the
+    default model on the same points, serial and on 2 workers, interleaved in ``rounds``
+    rounds (the machine is shared): points per second, their ratio, returns agreement, the
+    largest peak-to-peak deviation from the default, the simulated edges; and where the time
+    of an accuracy point goes (its runs)."""
+    import tempfile
+    from mjeap.analysis.stability import MAP_BASE, simulated_edges
+    from mjeap.sweep import grid, read_results, run_sweep
+    pts = grid(payload_mass=[m * 1e-6 for m in masses], amplitude=list(amplitudes))
+    out = {"case": f"stability map points ({len(pts)}: {', '.join(map(str, masses))} mg x {amplitudes} V; the "
+                   "relaxed column load 76 mg between 74 and 78), pedot-micro standing, 30 s, square 0.1 Hz",
+           "rounds": rounds}
+    walls = {}
+    rows = {}
+    with tempfile.TemporaryDirectory() as d:
+        for k in range(rounds):
+            for executor, workers in (("serial", 1), ("processes", 2)):
+                for label, extra in (("default", {}), ("accuracy_1e-2", {"accuracy": 1e-2})):
+                    key = f"{executor}_{workers}_{label}"
+                    path = Path(d) / f"{key}_{k}.csv"
+                    res = run_sweep(pts, path, metrics=("returns", "peak_to_peak"), base={**MAP_BASE, **extra},
+                                    executor=executor, workers=workers, progress=False)
+                    walls.setdefault(key, []).append(res.wall_s)
+                    rows[key] = read_results(path)
+    for executor, workers in (("serial", 1), ("processes", 2)):
+        d_key, a_key = f"{executor}_{workers}_default", f"{executor}_{workers}_accuracy_1e-2"
+        rate_d = len(pts) / min(walls[d_key])
+        rate_a = len(pts) / min(walls[a_key])
+        ref = {(r["payload_mass"], r["amplitude"]): r for r in rows[d_key]}
+        dev = [abs(float(r["peak_to_peak"]) / float(ref[(r["payload_mass"], r["amplitude"])]["peak_to_peak"]) - 1)
+               for r in rows[a_key]]
+        same = [r["returns"] == ref[(r["payload_mass"], r["amplitude"])]["returns"] for r in rows[a_key]]
+        out[f"{executor}_{workers}_workers"] = {
+            "default_points_per_s": rate_d, "accuracy_points_per_s": rate_a, "ratio": rate_a / rate_d,
+            "returns_equal": f"{sum(same)} of {len(same)}", "max_peak_to_peak_deviation": max(dev),
+            "failed": sum(bool(r["error"]) for r in rows[a_key])}
+    for label in ("default", "accuracy_1e-2"):
+        rs = rows[f"serial_1_{label}"]
+        m = np.array([float(r["payload_mass"]) for r in rs]) * 1e6
+        v = np.array([float(r["amplitude"]) for r in rs])
+        ok = np.array([r["returns"] == "True" for r in rs])
+        out[f"edges_mg_{label}"] = {f"{a:g} V": e for a, e in simulated_edges(m, v, ok).items()}
+    from mjeap import Scene, rollout
+    s = Scene("pedot-micro", orientation="up", payload="76mg@6.27mm")
+    t0 = time.perf_counter()
+    r = rollout(s, "square:1.0V@0.1Hz", 30.0, progress=False, accuracy=1e-2, metrics=("returns", "peak_to_peak"))
+    a = r.meta["accuracy"]
+    out["one_point_76mg_1V"] = {"wall_s": time.perf_counter() - t0, "model": a["model"],
+                                "runs": [{k: x[k] for k in ("role", "segments", "timestep", "wall_time_s")}
+                                         for x in a["runs"]],
+                                "damped_modes": a["damped_modes"], "estimated_error": {
+                                    k: x["estimated_error"] for k, x in a["metrics"].items()}}
+    return out
+
+
 def bench_early_stop(map_points=8):
     """The stability map's bench points (as in native and accuracy) at the map's 30 s (three
     periods: too short for a stop, which needs four) and at 60 s, run to the end and with
@@ -635,8 +692,8 @@ def bench_warp(map_points=4, duration=1.0, batch=16, batch_duration=0.6):
     return out
 
 
-BENCHMARKS = ("models", "rollout", "drives", "threaded", "elastica", "sweep", "native", "accuracy", "early_stop",
-              "optimize", "warp")
+BENCHMARKS = ("models", "rollout", "drives", "threaded", "elastica", "sweep", "native", "accuracy", "metric_map",
+              "early_stop", "optimize", "warp")
 
 
 def main(argv=None):
@@ -682,6 +739,8 @@ def main(argv=None):
             out["native"] = bench_native()
         elif name == "accuracy":
             out["accuracy"] = bench_accuracy()
+        elif name == "metric_map":
+            out["metric_map"] = bench_metric_map()
         elif name == "early_stop":
             out["early_stop"] = bench_early_stop()
         elif name == "optimize":

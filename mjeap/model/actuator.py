@@ -14,6 +14,9 @@ from .section import SectionLayer, SectionProperties, multilayer_section
 
 __all__ = ["Layer", "Planform", "Sourced", "Actuator", "validate_actuator"]
 
+#: 8-point Gauss-Legendre nodes and weights on [-1, 1] (the layered mass's quadrature)
+_GAUSS_8 = np.polynomial.legendre.leggauss(8)
+
 
 @dataclass(frozen=True)
 class Layer:
@@ -139,7 +142,7 @@ class Actuator:
         return mu
 
     def _layered_mass(self) -> float:
-        xg, wg = np.polynomial.legendre.leggauss(8)
+        xg, wg = _GAUSS_8
         x = 0.5 * self.length * (xg + 1.0)
         return float(0.5 * self.length * np.sum(wg * [self.section_at(v).mass_per_length for v in x]))
 

@@ -199,8 +199,12 @@ def _cost(model: Model, duration: float) -> float:
 
 
 def choose_model(scene, error_model: ErrorModel, target: float, duration: float, grid: float,
-                 h_cap: float) -> Model:
-    """The cheapest model with predicted error <= target / SAFETY (h on the sample grid)."""
+                 h_cap: float, *, widest: int = COMPANION_STEPS[-1], cost=None, integrator=None) -> Model:
+    """The cheapest model with predicted error <= target / SAFETY (h on the sample grid /
+    ``widest``, the widest companion's step factor, so that every companion's step divides
+    the grid); ``cost(model, duration)`` and ``integrator(scene, h)``: this module's
+    unless given."""
+    cost, integrator = cost or _cost, integrator or _integrator_for
     tau = target / SAFETY
     best = None
     for n in range(MIN_SEGMENTS, MAX_SEGMENTS + 1):
@@ -209,13 +213,13 @@ def choose_model(scene, error_model: ErrorModel, target: float, duration: float,
             continue
         room = math.sqrt(tau ** 2 - e_n ** 2)
         h = h_cap if error_model.temporal <= 0 else min(h_cap, room / error_model.temporal)
-        h = _on_grid(h, grid / COMPANION_STEPS[-1])          # the companions' steps divide the grid too
-        m = Model(n, h, _integrator_for(scene, h))
-        if best is None or _cost(m, duration) < _cost(best, duration):
+        h = _on_grid(h, grid / widest)
+        m = Model(n, h, integrator(scene, h))
+        if best is None or cost(m, duration) < cost(best, duration):
             best = m
     if best is None:         # even MAX_SEGMENTS are predicted too coarse: the finest there is
-        h = _on_grid(min(h_cap, 0.5 * tau / max(error_model.temporal, 1e-300)), grid / COMPANION_STEPS[-1])
-        best = Model(MAX_SEGMENTS, h, _integrator_for(scene, h))
+        h = _on_grid(min(h_cap, 0.5 * tau / max(error_model.temporal, 1e-300)), grid / widest)
+        best = Model(MAX_SEGMENTS, h, integrator(scene, h))
     return best
 
 

@@ -52,7 +52,7 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
             progress: Optional[bool] = None, check_every: int = 100, controller=None,
             engine: str = "auto", max_steps: Optional[int] = None, accuracy: Optional[float] = None,
             estimate_error: bool = False, error_model=None,
-            stop_when_periodic: Optional[float] = None) -> RolloutResult:
+            stop_when_periodic: Optional[float] = None, metrics: Optional[Sequence[str]] = None) -> RolloutResult:
     """Run ``scene`` driven by ``drive`` (name, instance or None for the actuator's own)
     with ``voltage`` (waveform text, :class:`Waveform` or callable v(t)) for ``duration`` s,
     or closed loop under ``controller`` (``voltage`` then None): a callable
@@ -78,7 +78,10 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     then estimates its error with a coarser companion run (about 0.35 x the cost).
     ``error_model`` (with a target): the constants (a, b) of a similar question's run, its
     ``meta['accuracy']['error_model']``, in place of this run's pilots
-    (:func:`mjeap.simulation.accuracy.run_at_accuracy`).
+    (:func:`mjeap.simulation.accuracy.run_at_accuracy`). ``metrics`` (with a target): the
+    target applies to these metrics of the run (peak_to_peak, returns, ...), each relative
+    to its own scale, not to the trajectory; slow questions then take steps far beyond the
+    modes' resolution (:mod:`mjeap.simulation.metric_accuracy`).
 
     ``stop_when_periodic`` (relative tolerance, periodic waveforms): the run stops at the
     first period boundary, from the third, where its last period repeats the one before
@@ -96,6 +99,9 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     drv = drive if (drive is not None and not isinstance(drive, str)) else \
         make_drive(drive, scene, **(drive_params or {}))
     target = target_for(scene, accuracy)
+    if metrics is not None:
+        from .metric_accuracy import check_metrics
+        metrics = check_metrics(metrics)
     if error_model is not None:         # its values are checked by run_at_accuracy, before any run
         if target is None:
             raise ParameterError("error_model", error_model, "None without an accuracy target (it chooses the model "
@@ -107,7 +113,7 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
         scene.part.check_derivable()
         return _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, csv_path, sample_interval,
                                     check_every, controller, engine, max_steps, target, wave, error_model,
-                                    stop_when_periodic)
+                                    stop_when_periodic, metrics)
     eng, engine_reason = choose(engine, scene, drv, controller)
     dt = scene.timestep
     v_steps = voltage_steps(wave, duration, dt, drv, max_steps)
@@ -151,7 +157,7 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
 
 def _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, csv_path, sample_interval,
                          check_every, controller, engine, max_steps, target, wave, error_model=None,
-                         stop_when_periodic=None) -> RolloutResult:
+                         stop_when_periodic=None, metrics=None) -> RolloutResult:
     """:func:`rollout` at an accuracy target (or, without one, with its error estimated): the
     runs of :mod:`mjeap.simulation.accuracy`, each with the drive ``drv`` names and its parameters;
     the outputs hold the chosen run, whose meta says how it was chosen."""
@@ -170,7 +176,12 @@ def _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, 
                        check_every=check_every, controller=controller, engine=engine, max_steps=max_steps,
                        stop_when_periodic=stop)
 
-    if target is None:
+    if target is not None and metrics:
+        from .metric_accuracy import run_metrics_at_accuracy
+        result, chosen, _ = run_metrics_at_accuracy(scene, run, metrics=metrics, accuracy=target, duration=duration,
+                                                    drive=drv, wave=wave, sample_interval=sample_interval,
+                                                    error_model=error_model)
+    elif target is None:
         chosen = scene
         result = run(scene, sample_interval)
         acc.estimate_error(scene, run, result, duration=duration, sample_interval=sample_interval)
@@ -197,7 +208,8 @@ def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable
                   drive: Optional[str] = None, drive_params: Optional[dict] = None,
                   initial_curvatures: Union[float, Sequence[float]] = 0.0,
                   sample_interval: Optional[float] = None, nthread: Optional[int] = None,
-                  engine: str = "auto", accuracy: Optional[float] = None) -> List[RolloutResult]:
+                  engine: str = "auto", accuracy: Optional[float] = None,
+                  metrics: Optional[Sequence[str]] = None) -> List[RolloutResult]:
     """Many rollouts of one scene, one per entry of ``voltages`` (and of
     ``initial_curvatures``, 1/m, a scalar for all; a single waveform runs once per initial
     curvature, or once), on MuJoCo's threaded rollout with ``nthread`` threads (1 to the
@@ -208,7 +220,8 @@ def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable
     scene's own): one model is chosen for the whole batch, from the pilots of its first
     member and then for its worst member (:mod:`mjeap.simulation.accuracy`: each member's
     error is measured on it, segments and step), and each result carries its own estimated
-    error."""
+    error. ``metrics`` (with a target): the target is on these metrics of each member, each
+    member choosing its own model as :func:`rollout` does (one by one)."""
     from ..drives import make_drive
     duration = check_positive("duration", duration, "s")
     if np.ndim(initial_curvatures) == 0:
@@ -231,6 +244,13 @@ def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable
                              f"one number (1/m) for all or one per voltage ({len(voltages)})")
     kappa0 = [check_initial_curvature(k, scene.layout.length, "initial_curvatures") for k in kappa0]
     target = target_for(scene, accuracy)
+    if metrics is not None:
+        from .metric_accuracy import check_metrics
+        metrics = check_metrics(metrics)
+    if target is not None and metrics is not None:       # each member's own model for its answer
+        return [rollout(scene, v, duration, drive=drive, drive_params=drive_params, initial_curvature=k,
+                        sample_interval=sample_interval, progress=False, engine=engine, accuracy=target,
+                        metrics=metrics) for v, k in zip(voltages, kappa0)]
     if target is not None:
         from .accuracy import run_at_accuracy
         scene.part.check_derivable()

@@ -12,27 +12,25 @@ from typing import Callable, Dict, Optional, Sequence
 import numpy as np
 
 from ..errors import DivergenceError, ParameterError, check_registration
+from ..simulation.metric_accuracy import peak_to_peak, returns_margin
 from .design import PARAMETERS
 
 
-def _last_period(r, point):
-    f = point.get("frequency") or 0.0
-    t_end = r.time[-1]
-    t0 = t_end - 1.0 / f if f > 0 and 1.0 / f < t_end else 0.5 * t_end
-    return r.time >= t0
+def _period(point) -> Optional[float]:
+    f = float(point.get("frequency") or 0.0)
+    return 1.0 / f if f > 0 else None
 
 
 def metric_peak_to_peak(r, point, scene) -> float:
     """Peak-to-peak tip curvature (1/m) over the last drive period (the second half of the
     run without a frequency)."""
-    return float(np.ptp(r.tip_curvature[_last_period(r, point)]))
+    return peak_to_peak(r.time, r.tip_curvature, _period(point))
 
 
 def metric_returns(r, point, scene) -> bool:
     """Seed 000's stability criterion: the tip curvature still changes sign in the last
     drive period (the actuator follows the drive instead of staying collapsed)."""
-    k = r.tip_curvature[_last_period(r, point)]
-    return bool(k.max() > 0 > k.min())
+    return returns_margin(r.time, r.tip_curvature, _period(point)) > 0
 
 
 def metric_settling_time(r, point, scene) -> float:
@@ -65,7 +63,10 @@ def metric_estimated_error(r, point, scene) -> str:
     if not a:
         return ""
     m = a["model"]
-    how = "shared error model" if any(x["role"] == "spatial companion" for x in a.get("runs", ())) else "pilots"
+    if "metrics" in a:          # a target on the metrics (mjeap.simulation.metric_accuracy)
+        how = "shared error model" if a["error_model"]["pilots"] == "given" else "no prior"
+    else:
+        how = "shared error model" if any(x["role"] == "spatial companion" for x in a.get("runs", ())) else "pilots"
     return (f"{a['estimated_error']:.3g} ({m['segments']} segments, {m['integrator']}, h = {m['timestep']:.3g} s; "
             f"{how}, {a.get('refinements', 0)} refinements)")
 

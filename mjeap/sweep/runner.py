@@ -67,6 +67,8 @@ def evaluate(point: dict, metrics: Sequence[str] = ("peak_to_peak", "returns"), 
             row["_error_model"] = None if e is None else (e["spatial_a"], e["temporal_b_per_s"])
         for m in dynamic:
             row[m] = metric_value(m, _metrics.METRICS[m](r, p, scene))
+        for m, est in (r.meta.get("accuracy", {}).get("metrics", {}) if r is not None else {}).items():
+            row[f"estimated_error.{m}"] = est["estimated_error"]
     except MjeapError as e:
         row["error"] = f"{type(e).__name__}: {e}"
         if "returns" in metrics and isinstance(e, DivergenceError):
@@ -94,9 +96,23 @@ def _run_point(p: dict, scene, metrics: Sequence[str], rrd_dir, pid: str, error_
         interval = dt * max(1, -(-int(round(duration / dt)) // _metrics.MAX_STEP_SAMPLES))
     elif metrics and all(m in _metrics.END_METRICS for m in metrics) and not at_target and stop is None and rrd is None:
         interval = duration / 8.0
+    targeted = targeted_metrics(metrics) if at_target else ()
     return rollout(scene, wave, duration, drive_params=drive_params, initial_curvature=float(p["initial_curvature"]),
                    progress=False, rrd=rrd, engine=p["engine"], sample_interval=interval,
-                   error_model=error_model if at_target else None, stop_when_periodic=stop)
+                   error_model=error_model if at_target else None, stop_when_periodic=stop,
+                   metrics=targeted or None)
+
+
+def targeted_metrics(metrics: Sequence[str]) -> tuple:
+    """The metrics an accuracy target applies to (:mod:`mjeap.simulation.metric_accuracy`):
+    all the point's rollout metrics where each is one it answers (bookkeeping columns
+    aside), else none (the target is then on the trajectory)."""
+    from ..simulation.metric_accuracy import BOOKKEEPING, answerable
+    return tuple(m for m in metrics if m not in BOOKKEEPING) if answerable(metrics) else ()
+
+
+def _at_target(points, base) -> bool:
+    return any({**PARAMETERS, **(base or {}), **p}["accuracy"] not in (None, "") for p in points or [{}])
 
 
 # ---------------------------------------------------------------- many points
@@ -384,7 +400,8 @@ def _run_locked(points, path, metrics, base, executor, workers, scheduler, recor
     jobs = [(p, tuple(metrics), base, rrd_dir if i in record else None) for i, p in enumerate(points)
             if point_id(p, base, metrics) not in done_ids]
     skipped = len(points) - len(jobs)
-    columns = ["point_id", *sorted({k for p in points for k in p}), *metrics, "error", "wall_s", "settings"]
+    estimates = [f"estimated_error.{m}" for m in targeted_metrics(metrics)] if _at_target(points, base) else []
+    columns = ["point_id", *sorted({k for p in points for k in p}), *metrics, *estimates, "error", "wall_s", "settings"]
     path.parent.mkdir(parents=True, exist_ok=True)
     new_file = not path.exists() or path.stat().st_size == 0
     if not new_file:

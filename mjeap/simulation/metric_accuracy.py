@@ -1,0 +1,388 @@
+"""Runs at a stated accuracy on the answer: a target on named metrics of the tip curvature
+(a sweep's, a map's, an optimisation's), not on the whole trajectory
+(:mod:`mjeap.simulation.accuracy`).
+
+Each metric's error is taken relative to its own scale (:data:`METRIC_SCALES`):
+
+* ``peak_to_peak`` (last drive period): the swing of the run (peak-to-peak tip curvature
+  over the whole run), as the trajectory's target is;
+* ``max_stress_proxy``, ``max_tip_deflection``: their own value;
+* ``settling_time``: the drive period (the run's duration without one);
+* ``returns`` (a boolean: the tip curvature changes sign in the last period): its margin,
+  min(max kappa, -min kappa) over the last period relative to the swing (> 0: returns). It is
+  *decided* only where |margin| exceeds the margin's estimated error; else the run is
+  refined, and a point still undecided after MAX_REFINEMENTS is run on the scene's own
+  (default) model, which then decides it (``decided_by`` says so): no point is left undecided.
+
+Time-scale separation. A question read on the last drive period (:data:`LAST_PERIOD_METRICS`)
+whose drive is slow against the beam's modes (the drive's fastest time constant, 1 / its
+fastest pole or zero or its ``time_constant``, at least SEPARATION / omega_1) is answered with steps far beyond the modes' resolution under 'discrete':
+backward Euler damps the fast modes (overdamped above f = 1 / (pi h), said in
+``meta['accuracy']['damped_modes']``) and keeps the slow path. The step is chosen by the
+error model on the answer and bounded by the drive's fastest time constant / STEPS_PER_TAU,
+the waveform's period / STEPS_PER_DRIVE_PERIOD and the sample interval, not by beta / 2 (the
+refusal of such steps stays for trajectories and for user timesteps). Maxima over the whole
+run (they read the release transient), drives without a time constant (the piezo bimorph,
+the electrostrictive film) and electrical quantities (power, current, phase: not metrics of
+this module; a sweep asking for them puts its target on the trajectory) keep the
+trajectory's bound, 1/8 of the first mode's period, and beta / 2 (on pvdf-60's release
+ringing a step of 1/8 period, damped by backward Euler in the run and its companions alike,
+was 38 x off its estimate).
+
+A posteriori, on the same quantities: the chosen run F = (N, h), a companion of the same N
+at 2 h and one of :func:`~mjeap.simulation.accuracy.fewer_segments` at 2 h. The step's error
+of each metric is |q(F) - q(F_2h)| / scale (order 1 assumed: backward Euler with the drive
+held over the step; 3 x high where it is 2), the
+segments' error |q(F_2h) - q(S_2h)| / scale / ((N / n)^2 - 1) (order 2), and where F is
+sampled coarser than its step (a user's interval) the sampling's, |q(F) - q(F every other
+sample)| / 3, combined in quadrature. Each run is sampled every step otherwise: the drive
+held over a step puts a square wave's peak one step after its switch, and a grid coarser
+than the step reads the models' peaks unequally (on thick-trilayer's length sweep that hid
+a 0.7 % error from the companions). Where a metric's estimate exceeds the target (or a boolean is undecided), the
+error model e = sqrt((a / N^2)^2 + (b h)^2) takes a and b from the measured parts and a finer
+model is run. Measured numbers: docs/concepts/accuracy.md, scripts/bench.py.
+"""
+from __future__ import annotations
+
+import math
+import time as _time
+from dataclasses import asdict
+from typing import Dict, List, Optional, Sequence
+
+import numpy as np
+
+from ..errors import ParameterError
+from .accuracy import SAFETY, ErrorModel, Model, as_error_model, check_accuracy, choose_model, fewer_segments
+
+__all__ = ["METRIC_SCALES", "check_metrics", "answerable", "relaxed_step_cap", "last_period",
+           "peak_to_peak", "returns_margin", "metric_quantity", "metric_scale", "run_metrics_at_accuracy"]
+
+#: the metrics a target may be put on, and the scale each one's error is relative to
+METRIC_SCALES = {"peak_to_peak": "swing", "returns": "margin", "max_stress_proxy": "value",
+                 "max_tip_deflection": "value", "settling_time": "period"}
+#: metrics read on the last drive period: slow questions where the drive is (time-scale
+#: separation); the others (a maximum over the run, a settling time) read the release
+#: transient and keep the trajectory's step bound
+LAST_PERIOD_METRICS = ("peak_to_peak", "returns")
+#: a relaxed step divides the drive period / SAMPLES_PER_PERIOD (the square wave's switching
+#: instants on its grid)
+SAMPLES_PER_PERIOD = 100
+#: bookkeeping columns of a sweep: not quantities, ignored where a target's metrics are read
+BOOKKEEPING = ("estimated_error", "stopped_early")
+#: the drive's fastest time constant must be this many x the first mode's 1 / omega_1
+SEPARATION = 10.0
+#: steps per drive time constant and per drive period, at most
+STEPS_PER_TAU = 20
+STEPS_PER_DRIVE_PERIOD = 100
+#: the first model tried without an error model: segments (the step: the cap)
+START_SEGMENTS = 8
+#: the step's error of a metric from one companion at 2 h: d / (2^p - 1) with the order p =
+#: 1 assumed (backward Euler with the drive held over the step: the beam follows a step
+#: late; measured first order on thick-trilayer's length sweep, where p = 1.5 gave 0.56 x
+#: the true error): 3 x high where the order is 2
+STEP_RICHARDSON = 1.0
+MAX_REFINEMENTS = 3
+#: cost of a run of a model: RUN_OVERHEAD + steps x (c0 + c1 N) (us; this 2-core machine,
+#: the map's scene: building a variant and a rollout's set-up cost about 25 ms)
+RUN_OVERHEAD_US = 25_000.0
+COST_PER_STEP = (3.0, 0.6)
+#: a model is never chosen with more steps than this (a boolean at its edge falls back to
+#: the scene's own model instead)
+MAX_MODEL_STEPS = 2_000_000
+
+
+def check_metrics(metrics) -> tuple:
+    """``metrics`` as a tuple of names of :data:`METRIC_SCALES`, refused otherwise."""
+    if isinstance(metrics, str):
+        metrics = (metrics,)
+    try:
+        names = tuple(str(m) for m in metrics)
+    except TypeError:
+        names = ()
+    bad = [m for m in names if m not in METRIC_SCALES] if names else [metrics]
+    if bad:
+        raise ParameterError("metrics", bad[0], f"names among {', '.join(METRIC_SCALES)} (a target on the "
+                             "trajectory: leave metrics out)")
+    return names
+
+
+def answerable(metrics: Sequence[str]) -> bool:
+    """Whether a target on ``metrics`` (a sweep's, bookkeeping columns aside) is one this
+    module answers: all of them tip-curvature metrics of :data:`METRIC_SCALES`."""
+    names = [m for m in metrics if m not in BOOKKEEPING]
+    return bool(names) and all(m in METRIC_SCALES for m in names)
+
+
+def _drive_tau(drive) -> Optional[float]:
+    """The drive's fastest time constant (s): 1 / its fastest pole or zero, else its
+    ``time_constant`` parameter; None without either (an instantaneous drive)."""
+    tf = getattr(drive, "transfer_function", None)
+    if tf is None:
+        tau = getattr(drive, "params", {}).get("time_constant")
+        return float(tau) if tau else None
+    try:
+        f = tf()
+        rates = [abs(complex(x)) for x in list(f.poles) + list(f.zeros)]
+    except Exception:           # a drive without a linear form
+        return None
+    rates = [x for x in rates if x > 0]
+    return 1.0 / max(rates) if rates else None
+
+
+def relaxed_step_cap(scene, drive, wave, metrics: Sequence[str] = LAST_PERIOD_METRICS) -> tuple:
+    """(h_cap s, why) for a target on ``metrics``: the drive's fastest time constant /
+    STEPS_PER_TAU and the waveform's period / STEPS_PER_DRIVE_PERIOD where every metric reads
+    the last period and the drive is slow against the first mode (time-scale separation),
+    else (None, why not)."""
+    fast = [m for m in metrics if m not in LAST_PERIOD_METRICS]
+    if fast:
+        return None, f"{fast[0]} reads the whole run (its release transient is as fast as the beam's modes)"
+    if wave is None or not getattr(wave, "frequency", 0):
+        return None, "no drive period (the metrics' last period is the run's second half)"
+    tau = _drive_tau(drive)
+    w1 = 2 * math.pi * scene.choice.first_frequency
+    if tau is None:
+        return None, f"the {getattr(drive, 'name', 'drive')} drive has no time constant to bound the step"
+    if tau * w1 < SEPARATION:
+        return None, (f"the drive's fastest time constant {tau:.3g} s is not {SEPARATION:g} x slower than the first "
+                      f"mode (1 / omega_1 = {1 / w1:.3g} s)")
+    cap = tau / STEPS_PER_TAU
+    f = getattr(wave, "max_frequency", 0.0) or getattr(wave, "frequency", 0.0) or 0.0
+    if f > 0:
+        cap = min(cap, 1.0 / (STEPS_PER_DRIVE_PERIOD * f))
+    return cap, (f"time-scale separation: the drive's fastest time constant {tau:.3g} s against the first mode's "
+                 f"1 / omega_1 = {1 / w1:.3g} s; step at most tau / {STEPS_PER_TAU}"
+                 + (f" and the drive period / {STEPS_PER_DRIVE_PERIOD}" if f > 0 else ""))
+
+
+# ---------------------------------------------------------------- the quantities
+def last_period(time: np.ndarray, period: Optional[float]) -> np.ndarray:
+    """Mask of the samples in the last drive period (``period`` s; the second half of the
+    run without one, or where the run is not longer than it)."""
+    t_end = time[-1]
+    t0 = t_end - period if period and period < t_end else 0.5 * t_end
+    return time >= t0 - 1e-9 * t_end           # the sample at the period's start (round-off) included
+
+
+def peak_to_peak(time, kappa, period) -> float:
+    """Peak-to-peak tip curvature (1/m) over the last drive period."""
+    return float(np.ptp(kappa[last_period(time, period)]))
+
+
+def returns_margin(time, kappa, period) -> float:
+    """min(max kappa, -min kappa) over the last drive period (1/m): > 0 where the tip
+    curvature changes sign there (seed 000's criterion), its distance from deciding else."""
+    k = kappa[last_period(time, period)]
+    return float(min(k.max(), -k.min()))
+
+
+def _settling_time(r) -> float:
+    k = r.tip_curvature
+    band = 0.02 * max(abs(k[-1] - k[0]), 1e-300)
+    outside = np.nonzero(np.abs(k - k[-1]) > band)[0]
+    return float(r.time[outside[-1] + 1]) if outside.size and outside[-1] + 1 < k.size else 0.0
+
+
+def metric_quantity(name: str, r, period: Optional[float]) -> float:
+    """The number behind metric ``name`` in run ``r`` (its margin for ``returns``)."""
+    if name == "peak_to_peak":
+        return peak_to_peak(r.time, r.tip_curvature, period)
+    if name == "returns":
+        return returns_margin(r.time, r.tip_curvature, period)
+    if name == "max_stress_proxy":
+        return float(np.abs(r.tip_curvature).max())
+    if name == "max_tip_deflection":
+        return float(np.abs(r.tip_position[:, 1]).max())
+    return _settling_time(r)
+
+
+def metric_scale(name: str, r, value: float, period: Optional[float], duration: float) -> float:
+    """The scale of metric ``name``'s error in run ``r`` (:data:`METRIC_SCALES`)."""
+    kind = METRIC_SCALES[name]
+    if kind in ("swing", "margin"):
+        return float(np.ptp(r.tip_curvature))
+    if kind == "period":
+        return period or duration
+    return abs(value)
+
+
+def _relative(x: float, scale: float) -> float:
+    return x / scale if scale > 0 else (0.0 if x == 0 else math.inf)
+
+
+# ---------------------------------------------------------------- the choice
+def _cost(model: Model, duration: float) -> float:
+    c0, c1 = COST_PER_STEP
+    return RUN_OVERHEAD_US + duration / model.timestep * (c0 + c1 * model.segments)
+
+
+def _on_grid(h: float, grid: float) -> float:
+    return grid / max(1, math.ceil(grid / h * (1 - 1e-12)))
+
+
+def _integrator(scene, h: float) -> str:
+    """'implicitfast' where h and the 2 h companion stay within the Rayleigh beta (about its
+    stability limit), else 'discrete'."""
+    return "implicitfast" if 2 * h <= scene.choice.rayleigh_beta else "discrete"
+
+
+def _choose(scene, em: ErrorModel, target: float, duration: float, grid: float, h_cap: float) -> Model:
+    """The cheapest model with predicted error <= target / SAFETY, h on the grid / 2 (the
+    2 h companion's step divides it), a run's overhead in its cost."""
+    return choose_model(scene, em, target, duration, grid, h_cap, widest=2, cost=_cost, integrator=_integrator)
+
+
+class _EveryOther:
+    """A run's samples, every other one (the sampling's own companion)."""
+
+    def __init__(self, r):
+        self.time, self.tip_curvature, self.tip_position = r.time[::2], r.tip_curvature[::2], r.tip_position[::2]
+
+
+#: the sampling's error of a metric from its value on every other sample: d / (2^2 - 1), a
+#: smooth extremum read between samples being off by O(interval^2)
+SAMPLING_RICHARDSON = 3.0
+
+
+def _evaluate(metrics, runs, period, duration, step) -> Dict[str, dict]:
+    """Each metric's value on the chosen run and its (step, segments, sampling) errors
+    relative to its scale, from the runs (F, F_2h, S_2h) and the segment counts (N, n);
+    the sampling's only where F was sampled coarser than its ``step``."""
+    (f, mid, fewer), (n_f, n_s) = runs
+    coarse = len(f.time) > 1 and f.time[1] - f.time[0] > 1.5 * step      # sampled coarser than its step
+    sparse = _EveryOther(f)
+    out = {}
+    for name in metrics:
+        q = [metric_quantity(name, r, period) for r in (f, mid, fewer, sparse)]
+        scale = metric_scale(name, f, q[0], period, duration)
+        e_h = _relative(abs(q[0] - q[1]), scale) / STEP_RICHARDSON
+        e_s = _relative(abs(q[1] - q[2]), scale) / ((n_f / n_s) ** 2 - 1)
+        e_t = _relative(abs(q[0] - q[3]), scale) / SAMPLING_RICHARDSON if coarse else 0.0
+        e = math.sqrt(e_h ** 2 + e_s ** 2 + e_t ** 2)
+        row = {"value": q[0], "estimated_error": e, "step_error": e_h, "segments_error": e_s,
+               "sampling_error": e_t, "scale": METRIC_SCALES[name]}
+        if name == "returns":
+            margin = _relative(q[0], scale)
+            row.update(margin=margin, decided=abs(margin) > e)
+        out[name] = row
+    return out
+
+
+def _needs(metrics: Dict[str, dict], target: float) -> float:
+    """The error the next model must reach: the target, and below each undecided boolean's
+    margin; 0 where the run is good enough."""
+    worst = max(m["estimated_error"] for m in metrics.values())
+    need = target if worst > target else math.inf
+    for m in metrics.values():
+        if "decided" in m and not m["decided"]:
+            need = min(need, abs(m["margin"]) / 2)
+    return 0.0 if need == math.inf else need
+
+
+def run_metrics_at_accuracy(scene, run, *, metrics: Sequence[str], accuracy: float, duration: float, drive,
+                            wave=None, sample_interval: Optional[float] = None, error_model=None):
+    """Choose, run and check a model of ``scene`` whose ``metrics`` (names of
+    :data:`METRIC_SCALES`) are within ``accuracy`` of their scales. ``run(scene, interval)``
+    runs one model sampled every ``interval`` s (None: every step) and returns a
+    RolloutResult; ``drive`` (the question's drive) bounds the relaxed step. ``error_model``:
+    (a, b) of a similar question (a sweep's earlier point) choosing the first model. Returns
+    (result, scene of the chosen model, report), the report also in
+    ``result.meta['accuracy']`` with one entry per metric under ``'metrics'``."""
+    target = check_accuracy(accuracy)
+    names = check_metrics(metrics)
+    given = None if error_model is None else as_error_model(error_model)
+    if scene.builder.accuracy_reason is not None:
+        raise ParameterError("accuracy", accuracy, scene.builder.accuracy_reason)
+    t0 = _time.perf_counter()
+    period = 1.0 / wave.frequency if wave is not None and getattr(wave, "frequency", 0) else None
+    relaxed, why = relaxed_step_cap(scene, drive, wave, names)
+    # not relaxed: 1/8 of the first mode's period, and beta / 2 (the step's own damping under
+    # 'discrete' at most half the beam's: a maximum over the release transient reads its
+    # ringing, which a larger step damps in the run and its companions alike, unseen)
+    trajectory_cap = min(1.0 / (8 * scene.choice.first_frequency), 0.5 * scene.choice.rayleigh_beta or math.inf)
+    h_cap = relaxed if relaxed is not None else trajectory_cap
+    # each run sampled every step (a peak one step after a switch, the drive held over the
+    # step, is then each model's own); the relaxed step on a grid of the drive period
+    own_grid = relaxed is not None and sample_interval is None
+    grid = period / SAMPLES_PER_PERIOD if own_grid else (sample_interval or duration)
+    h_cap = min(h_cap, grid)
+    log: List[dict] = []
+
+    def one(model: Model, role: str, interval=None):
+        s = scene.variant(model.segments, model.timestep, model.integrator)
+        t = _time.perf_counter()
+        out = run(s, interval)
+        log.append({"role": role, **asdict(model), "wall_time_s": _time.perf_counter() - t})
+        return s, out
+
+    def attempt(model: Model, role: str):
+        chosen, f = one(model, role, sample_interval or model.timestep)
+        n_s = fewer_segments(model.segments)
+        h2 = 2 * model.timestep
+        every = sample_interval or h2
+        _, mid = one(Model(model.segments, h2, model.integrator), "companion", every)
+        _, fewer = one(Model(n_s, h2, model.integrator), "spatial companion", every)
+        return chosen, f, _evaluate(names, ((f, mid, fewer), (model.segments, n_s)), period, duration,
+                                    model.timestep)
+
+    if given is not None:
+        model = _choose(scene, given, target, duration, grid, h_cap)
+    else:
+        h0 = _on_grid(h_cap, grid / 2)
+        model = Model(START_SEGMENTS, h0, _integrator(scene, h0))
+    chosen, result, found = attempt(model, "chosen")
+    em = given or ErrorModel(0.0, 0.0)
+    refinements, decided_by = 0, None
+    need = _needs(found, target)
+    while need > 0 and refinements < MAX_REFINEMENTS:
+        em = ErrorModel(max(max(m["segments_error"] for m in found.values()) * model.segments ** 2, 1e-12),
+                        max(max(m["step_error"] for m in found.values()) / model.timestep, 1e-12))
+        nxt = _choose(scene, em, need, duration, grid, h_cap)
+        if duration / nxt.timestep > MAX_MODEL_STEPS or \
+                (nxt.segments <= model.segments and nxt.timestep >= model.timestep):
+            break
+        refinements += 1
+        model = nxt
+        chosen, result, found = attempt(model, "refined")
+        need = _needs(found, target)
+    undecided = [k for k, m in found.items() if "decided" in m and not m["decided"]]
+    if undecided:           # a boolean at its edge: the scene's own model decides it
+        t = _time.perf_counter()
+        result = run(scene, sample_interval)
+        log.append({"role": "default model (undecided at the target)", "segments": scene.layout.segments,
+                    "timestep": scene.timestep, "integrator": scene.integrator,
+                    "wall_time_s": _time.perf_counter() - t})
+        chosen, decided_by = scene, "the scene's own model: undecided by the chosen model's estimate"
+        for k in undecided:
+            found[k].update(value=metric_quantity(k, result, period), decided=True, decided_by=decided_by)
+    worst = max(m["estimated_error"] for m in found.values())
+    met = worst <= target
+    h = model.timestep
+    damped = None
+    if h > scene.choice.rayleigh_beta and model.integrator == "discrete":
+        damped = (f"modes above {1 / (math.pi * h):.3g} Hz overdamped by the step (backward Euler, h = {h:.3g} s; "
+                  f"first mode {scene.choice.first_frequency:.3g} Hz, its damping ratio raised to about "
+                  f"{math.pi * scene.choice.first_frequency * h:.2g}): the answer is the slow path")
+    report = {"quantity": "metrics: " + ", ".join(f"{k} (relative to its {METRIC_SCALES[k]})" for k in names),
+              "target": target, "model": asdict(model), "estimated_error": worst, "met": met,
+              "metrics": found, "relaxed_step": why if relaxed is not None else None,
+              "relaxed_step_refused": None if relaxed is not None else why, "damped_modes": damped,
+              "decided_by": decided_by,
+              "estimate": "each metric on the chosen run against companions of the same segments at 2 h (step, "
+                          "order 1 assumed) and of fewer segments at 2 h (segments, order 2), in quadrature",
+              "error_model": {"spatial_a": em.spatial, "temporal_b_per_s": em.temporal,
+                              "form": "e = sqrt((a / N^2)^2 + (b h)^2)",
+                              "pilots": "given" if given is not None else "none: measured on the runs"},
+              "refinements": refinements, "runs": log, "wall_time_s": _time.perf_counter() - t0}
+    if refinements == 0 and given is None:      # the error model of this question, for the next
+        report["error_model"].update(
+            spatial_a=max(max(m["segments_error"] for m in found.values()) * model.segments ** 2, 1e-12),
+            temporal_b_per_s=max(max(m["step_error"] for m in found.values()) / model.timestep, 1e-12))
+    result.meta["accuracy"] = report
+    if damped:
+        result.meta.setdefault("warnings", []).append(damped)
+    if not met:
+        result.meta.setdefault("warnings", []).append(
+            f"accuracy target {target:g} on {', '.join(names)} not met: estimated error {worst:.3g} with "
+            f"{Model(**report['model']).describe()} after {refinements} refinements")
+    return result, chosen, report

@@ -1,0 +1,43 @@
+"""The converged answers of the metric-accuracy claim's cases (mjeap.validation.metric_claim):
+REFERENCE_SEGMENTS segments at half each scene's default step, with their uncertainty,
+written to tests/golden/metric_accuracy.json (tests/test_metric_accuracy.py reads them).
+
+    python scripts/metric_goldens.py [--seed 36] [--cases 40] [--out tests/golden/metric_accuracy.json]
+    python scripts/metric_goldens.py --geometry [--out tests/golden/metric_accuracy_geometry.json]
+
+With --geometry: the converged peak_to_peak of a file actuator's length sweep
+(mjeap.validation.metric_claim.GEOMETRY) instead.
+"""
+import argparse
+import json
+import sys
+from pathlib import Path
+
+
+def main(argv=None):
+    from mjeap.io.commandline import arg_integer, parse_args
+    from mjeap.validation.metric_claim import converged, draw_cases, geometry_goldens
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--seed", type=arg_integer(0), default=36)
+    ap.add_argument("--cases", type=arg_integer(1, 1000), default=40)
+    ap.add_argument("--geometry", action="store_true", help="the length sweep's goldens instead of the cases'")
+    ap.add_argument("--out", default=None, help="default: tests/golden/metric_accuracy[_geometry].json")
+    a = parse_args(ap, argv)
+    root = Path(__file__).resolve().parents[1]
+    if a.geometry:
+        out = a.out or str(root / "tests/golden/metric_accuracy_geometry.json")
+        Path(out).write_text(json.dumps(geometry_goldens(root), indent=1, default=float) + "\n")
+        print(f"wrote {out}")
+        return
+    a.out = a.out or str(root / "tests/golden/metric_accuracy.json")
+    goldens = []
+    for i, case in enumerate(draw_cases(a.seed, a.cases)):
+        goldens.append(converged(case))
+        print(f"{i + 1}/{a.cases} {case.describe()}", flush=True)
+    Path(a.out).write_text(json.dumps({"seed": a.seed, "cases": goldens}, indent=1, default=float) + "\n")
+    print(f"wrote {a.out}")
+
+
+if __name__ == "__main__":
+    from mjeap.io.commandline import run_script
+    sys.exit(run_script(main))
