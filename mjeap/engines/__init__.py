@@ -78,11 +78,7 @@ def _samples_fault(smp, stopped_early: bool = False):
     n, ns = smp.n, smp.ns
     if not isinstance(n, (int, np.integer)) or not (1 <= n <= ns if stopped_early else n == ns):
         return f"it took {n!r} of the {ns} planned samples" + (" before it stopped early" if stopped_early else "")
-    points = smp._bodies.size + 1 + (smp.part.payload_id >= 0)       # clamp, links, tip[, payload]
-    arrays = {"times": (smp.t, (ns,)), "voltages": (smp.v, (ns,)), "positions": (smp._raw, (ns, points, 3)),
-              "orientations": (smp._xmat, (ns, 9))}
-    if smp._clamp_xmat is not None:
-        arrays["clamp orientations"] = (smp._clamp_xmat, (ns, 9))
+    arrays = smp.planned_arrays()
     wrong = [f"{k} of shape {np.shape(a)}, not {want}" for k, (a, want) in arrays.items() if np.shape(a) != want]
     wrong += [f"signal {k!r} of shape {np.shape(x)}, not ({n},) or longer"        # (n,): the native engine's
               for k, x in (smp.sig or {}).items() if np.ndim(x) != 1 or len(x) < n]

@@ -93,7 +93,7 @@ class Samples:
         self._bodies = np.r_[part.clamp_id, part.link_ids].astype(np.intp)
         self._raw = np.empty((ns, N + 2 + (part.payload_id >= 0), 3))
         self._xmat = np.empty((ns, 9))
-        self._moving = part._fixed_rotation is None
+        self._moving = part.clamp_moves
         self._clamp_xmat = np.empty((ns, 9)) if self._moving else None
         self.t, self.v = np.empty(ns), np.empty(ns)
         self.sig: Dict[str, np.ndarray] = {}
@@ -101,6 +101,17 @@ class Samples:
         #: called with this store after every sample; may raise a decision to stop the run
         #: (:class:`mjeap.simulation.periodic.PeriodicStop`)
         self.stop = None
+
+    def planned_arrays(self) -> dict:
+        """What a run fills, by name: (array, the shape planned for it): times, voltages,
+        raw positions (clamp, links, tip[, payload]), tip orientations and, where the clamp
+        moves, the clamp's."""
+        points = self._bodies.size + 1 + (self.part.payload_id >= 0)       # clamp, links, tip[, payload]
+        out = {"times": (self.t, (self.ns,)), "voltages": (self.v, (self.ns,)),
+               "positions": (self._raw, (self.ns, points, 3)), "orientations": (self._xmat, (self.ns, 9))}
+        if self._clamp_xmat is not None:
+            out["clamp orientations"] = (self._clamp_xmat, (self.ns, 9))
+        return out
 
     def _put(self, key, i, value):
         if key not in self.sig:

@@ -111,6 +111,6 @@ def run_native(scene, native, drives: Sequence, v_steps: Sequence[np.ndarray], i
     mujoco.mj_setState(m, d, final[-1], STATE)
     mujoco.mj_kinematics(m, d)
     drives[-1].native_leave(n, part, h, before=before[-1])
-    scene._step_count = n
+    scene.step_count = n
     if decided is not None:
         raise decided

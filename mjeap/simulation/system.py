@@ -473,11 +473,12 @@ class System:
             part.bind(self.data)
             if fixed:
                 mujoco.mj_kinematics(m, self.data)
-                part._fixed_rotation = self.data.xmat[clamp].reshape(3, 3).copy()
+                part.fix_rotation(self.data.xmat[clamp].reshape(3, 3))
             self.parts.append(part)
             self.actuator_ids.append(-1 if a.actuator_name is None else
                                      mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, a.actuator_name))
-        self._step_count = 0
+        #: steps since the last reset (the engines that step the system advance it)
+        self.step_count = 0
         self.reset()
 
     # ------------------------------------------------------------------ access
@@ -541,7 +542,7 @@ class System:
         for a, i in zip(self.actuators, self.actuator_ids):
             if i >= 0:
                 d.ctrl[i] = a.drive.rest_voltage()
-        self._step_count = 0
+        self.step_count = 0
 
     def _per_actuator(self, name: str, values) -> list:
         """One value per actuator from a list, a dict by prefix or one value for all; a bare
@@ -577,14 +578,14 @@ class System:
     def step(self, n: int = 1) -> None:
         """Advance ``n`` steps; raises :class:`DivergenceError` if the state blows up."""
         mujoco.mj_step(self.model, self.data, nstep=n)
-        self._step_count += n
+        self.step_count += n
         self.check_finite()
         mujoco.mj_kinematics(self.model, self.data)
 
     def check_finite(self) -> None:
         if diverged(self.data):
             raise DivergenceError(
-                f"system of {len(self)} actuators diverged by step {self._step_count} (t = {self.time:.6g} s): "
+                f"system of {len(self)} actuators diverged by step {self.step_count} (t = {self.time:.6g} s): "
                 f"timestep {self.timestep:.4g} s ({self.timestep_reason}); check the host's bodies, joints and "
                 "contacts (a stiff or light part may need a smaller timestep)")
 
@@ -749,7 +750,7 @@ class System:
                 mujoco.mj_getState(m, d, pre, full)
 
         def check(done, k):
-            self._step_count = done
+            self.step_count = done
             self.check_finite()
 
         try:
@@ -758,7 +759,7 @@ class System:
                 ctrl_every = controller_every(controller, dt)
                 self._control(controller(0.0, self), v_steps, 0, ctrl_name)
             run_system_checked(eng, self, n_steps, sample_steps, before, sample, check)
-            self._step_count = n_steps
+            self.step_count = n_steps
         except BaseException as e:
             error = e
             raise
