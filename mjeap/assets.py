@@ -17,7 +17,7 @@ from .engines.native import why_not
 from .model.fields import add_units
 from .model.catalog import CATALOG
 from .drives import make_drive
-from .model.mjcf import REPRESENTATIONS
+from .model.mjcf import FIXED_BENDING_FORCES, REPRESENTATIONS
 from .simulation.scene import Scene
 
 ASSET_DIR = Path(__file__).resolve().parent.parent / "assets" / "mjcf"
@@ -47,7 +47,7 @@ def asset_xml(actuator_id: str, representation: str) -> str:
     else:
         spec = s.spec.copy()
         add_units(spec, s.units)
-        engines = "loop engine" if s.builder.threaded_reason else "loop or threaded engine"
+        engines = "loop or threaded engine" if s.builder.has(FIXED_BENDING_FORCES) else "loop engine"
         drive_note = f"Passive beam: {why}. Drive it with mjeap ({engines})."
     add_viewing(spec, s)
     drive_note = "\n".join(textwrap.wrap(drive_note, 95, initial_indent=" " * 5, subsequent_indent=" " * 5)) + "\n"

@@ -30,6 +30,7 @@ import numpy as np
 from mujoco import rollout as mj_rollout
 
 from ..errors import DivergenceError
+from ..model.mjcf import FIXED_BENDING_FORCES
 from .base import CONTROLLER_REASON, Engine
 from .frame import Decided
 
@@ -55,8 +56,9 @@ def why_not(scene, drive, controller=None) -> Optional[str]:
     """None where the threaded engine applies to this run; else the reason, in words."""
     if controller is not None:
         return CONTROLLER_REASON
-    if scene.builder.threaded_reason is not None:
-        return scene.builder.threaded_reason
+    lack = scene.builder.lacks(FIXED_BENDING_FORCES)
+    if lack is not None:
+        return f"mujoco.rollout takes the drive's moments as fixed generalised forces (qfrc_applied controls): {lack}"
     reason = drive.closed_loop_reason()
     if reason is not None:
         return f"the {drive.name} drive is not open-loop: {reason}"

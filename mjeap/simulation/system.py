@@ -278,9 +278,11 @@ def attach(spec: mujoco.MjSpec, actuator, *, prefix: str, site: Optional[str] = 
     check_spec(spec)
     units = units or DEFAULT_UNITS
     from ..model.mjcf import get_builder
-    why = get_builder(representation).attach_reason
+    from ..model.mjcf import ATTACHED_WHOLE
+    why = get_builder(representation).lacks(ATTACHED_WHOLE)
     if why is not None:
-        raise ParameterError("representation", representation, "'hinge' (or 'cable' on MuJoCo 3.x) for attach", why)
+        raise ParameterError("representation", representation, "'hinge' (or 'cable' on MuJoCo 3.x) for attach: a "
+                             "beam that MjSpec.attach carries whole with its clamp body", why)
     integrator = integrator or ("discrete" if contact else "implicitfast")
     if not isinstance(prefix, str) or not _PREFIX.match(prefix):
         raise ParameterError("prefix", prefix, "a name of letters, digits, '_' or '-', starting with a letter")
