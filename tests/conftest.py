@@ -16,7 +16,7 @@ LAYER_FILES = {
     "drives": ("test_drive_ionic", "test_drive_electrostatic", "test_drive_allocation", "test_piezo_moment",
                "test_piezo_power", "test_pvdf_fidelity"),
     "engines": ("test_threaded", "test_native"),
-    "simulation": ("test_rollout", "test_system", "test_accuracy", "test_periodic", "test_golden"),
+    "simulation": ("test_rollout", "test_system", "test_pipeline", "test_accuracy", "test_periodic", "test_golden"),
     "analysis": ("test_identify", "test_self_sensing", "test_stability_map"),
     "applications": ("test_sweep", "test_design_sweeps", "test_optimize", "test_actuator_cli", "test_validation",
                      "test_controllers", "test_hamr_leg", "test_environment", "test_gymnasium_env"),

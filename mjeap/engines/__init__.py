@@ -24,10 +24,10 @@ from typing import Dict, List, Sequence, Tuple
 import numpy as np
 
 from ..errors import ParameterError, check_registration
-from .base import Engine
+from .base import Engine, SceneTarget, SystemTarget, Target
 from .frame import Decided
 
-__all__ = ["Engine", "register_engine", "get_engine", "engine_names", "choose", "choose_system", "stepper",
+__all__ = ["Engine", "Target", "SceneTarget", "SystemTarget", "register_engine", "get_engine", "engine_names", "choose", "choose_system", "stepper",
            "run_checked", "run_system_checked", "check_samples", "ENGINES"]
 
 
@@ -100,7 +100,7 @@ def check_samples(engine: Engine, samples: Sequence, stopped_early: bool = False
             raise _refuse_run(engine, (f"run {b + 1} of {len(samples)}: " if len(samples) > 1 else "") + fault)
 
 
-def run_checked(engine: Engine, scene, drives: Sequence, v_steps: Sequence, initial_curvatures: Sequence[float],
+def run_checked(engine: Engine, scene: SceneTarget, drives: Sequence, v_steps: Sequence, initial_curvatures: Sequence[float],
                 sample_steps, samples: Sequence, **kw) -> None:
     """``engine.run(...)`` (:meth:`Engine.run`), then its samples checked (:func:`check_samples`):
     a plug-in engine that fills too few samples or non-finite ones is refused naming it,
@@ -113,7 +113,7 @@ def run_checked(engine: Engine, scene, drives: Sequence, v_steps: Sequence, init
     check_samples(engine, samples)
 
 
-def run_system_checked(engine: Engine, system, n_steps: int, sample_steps, before, sample, check) -> None:
+def run_system_checked(engine: Engine, system: SystemTarget, n_steps: int, sample_steps, before, sample, check) -> None:
     """``engine.run_system(...)`` (:meth:`Engine.run_system`) with its sampling checked: a
     plug-in engine that skips, repeats or reorders a planned sample is refused naming it,
     and the state is checked (``check``) at every sample, so none is non-finite."""
