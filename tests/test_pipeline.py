@@ -50,7 +50,8 @@ def test_scenes_and_systems_are_the_targets_engines_declare():
     assert isinstance(scene, SceneTarget) and isinstance(scene, Target) and not isinstance(scene, SystemTarget)
     rollout(scene, "step:1V", 20 * scene.timestep, engine="loop")
     assert scene.step_count == 20                      # public, advanced by the engine
-    spec = mujoco.MjSpec.from_string('<mujoco><option gravity="0 0 0"/><worldbody><site name="m"/></worldbody></mujoco>')
+    spec = mujoco.MjSpec.from_string('<mujoco><option gravity="0 0 0"/><worldbody><site name="m"/></worldbody>'
+                                     '</mujoco>')
     system = System(spec, [mjeap.attach(spec, "pedot-micro", prefix="a", site="m", segments=4, contact=False)])
     assert isinstance(system, SystemTarget) and not isinstance(system, SceneTarget)
     system.rollout(["step:1V"], 20 * system.timestep)

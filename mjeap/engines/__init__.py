@@ -27,8 +27,8 @@ from ..errors import ParameterError, check_registration
 from .base import Engine, SceneTarget, SystemTarget, Target
 from .frame import Decided
 
-__all__ = ["Engine", "Target", "SceneTarget", "SystemTarget", "register_engine", "get_engine", "engine_names", "choose", "choose_system", "stepper",
-           "run_checked", "run_system_checked", "check_samples", "ENGINES"]
+__all__ = ["Engine", "Target", "SceneTarget", "SystemTarget", "register_engine", "get_engine", "engine_names", "choose",
+           "choose_system", "stepper", "run_checked", "run_system_checked", "check_samples", "ENGINES"]
 
 
 _REGISTRY: Dict[str, Engine] = {}
@@ -100,8 +100,8 @@ def check_samples(engine: Engine, samples: Sequence, stopped_early: bool = False
             raise _refuse_run(engine, (f"run {b + 1} of {len(samples)}: " if len(samples) > 1 else "") + fault)
 
 
-def run_checked(engine: Engine, scene: SceneTarget, drives: Sequence, v_steps: Sequence, initial_curvatures: Sequence[float],
-                sample_steps, samples: Sequence, **kw) -> None:
+def run_checked(engine: Engine, scene: SceneTarget, drives: Sequence, v_steps: Sequence,
+                initial_curvatures: Sequence[float], sample_steps, samples: Sequence, **kw) -> None:
     """``engine.run(...)`` (:meth:`Engine.run`), then its samples checked (:func:`check_samples`):
     a plug-in engine that fills too few samples or non-finite ones is refused naming it,
     not returned as an empty or NaN result. A :class:`Decided` goes on up."""

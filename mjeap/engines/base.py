@@ -78,9 +78,9 @@ class Engine:
         read: the scene's own unless the engine steps another model."""
         return scene.part
 
-    def run(self, scene: SceneTarget, drives: Sequence, v_steps: Sequence, initial_curvatures: Sequence[float], sample_steps,
-            samples: Sequence, *, nthread: int = 0, progress: Optional[bool] = None, check_every: int = 100,
-            controller=None, meta: Optional[dict] = None) -> None:
+    def run(self, scene: SceneTarget, drives: Sequence, v_steps: Sequence, initial_curvatures: Sequence[float],
+            sample_steps, samples: Sequence, *, nthread: int = 0, progress: Optional[bool] = None,
+            check_every: int = 100, controller=None, meta: Optional[dict] = None) -> None:
         """Roll out one run per drive (its voltage per step, initial curvature 1/m and sample
         store), filling the stores; raises DivergenceError at the first diverged state and
         leaves the scene in the final state of the last run."""

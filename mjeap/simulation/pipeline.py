@@ -17,7 +17,7 @@ from __future__ import annotations
 
 import time as _time
 from dataclasses import dataclass
-from typing import Callable, List, Optional, Sequence
+from typing import Callable, List, Optional, Sequence, Union
 
 import numpy as np
 
@@ -43,19 +43,22 @@ class Plan:
     meta: dict
 
 
-def plan(engine: Engine, engine_reason: str, waves: Sequence, drives: Sequence, parts: Sequence, duration: float,
+def plan(engine: Engine, engine_reason: str, waves: Sequence, drives: Sequence,
+         parts: Union[Sequence, Callable[[], Sequence]], duration: float,
          dt: float, sample_interval: Optional[float], meta: dict, *, max_steps: Optional[int] = None,
          remedy: str = SCENE_TIMESTEP, rest: bool = False) -> Plan:
     """The plan of a run of ``duration`` s at steps of ``dt`` s on ``engine`` (chosen for
     ``engine_reason``): per drive (None: passive) its ``waves`` entry's voltage per step
     (None: zero volts, or with ``rest`` the drive's rest voltage), checked (``remedy``: what
-    to change at the Nyquist frequency); the sample steps; a store per entry of ``parts``;
-    ``meta`` after the provenance, with the steps and the engine."""
+    to change at the Nyquist frequency); the sample steps; a store per entry of ``parts`` (or
+    of ``parts()``, called once the voltages passed: an engine's part may be a model it
+    compiles); ``meta`` after the provenance, with the steps and the engine."""
     n_steps = check_work(duration, dt, max_steps)
     v_steps = [None if d is None else np.full(n_steps, d.rest_voltage()) if (w is None and rest) else
                voltage_steps(w, duration, dt, d, max_steps, remedy) for w, d in zip(waves, drives)]
     steps = sample_steps(n_steps, dt, sample_interval)
     meta = {**provenance(), **meta, "steps": n_steps, "engine": engine.name, "engine_reason": engine_reason}
+    parts = parts() if callable(parts) else parts
     return Plan(engine, n_steps, steps, v_steps, [Samples(p, len(steps)) for p in parts], meta)
 
 

@@ -46,6 +46,12 @@ def _meta(scene, drv, wave, duration, initial_curvature) -> dict:
             "drive_parameters": {k: [v, drv.sources.get(k, "")] for k, v in drv.params.items()}}
 
 
+#: the warning of a run whose straight beam is unstable under gravity ({} the actuator)
+BUCKLED = ("{}: the straight beam is unstable under gravity (the payload is above the column load): the run starts "
+           "from that unstable equilibrium and only a disturbance (an initial curvature, a voltage) makes it buckle; "
+           "a result near zero here is not a stable beam")
+
+
 @guarded("rrd", "csv_path")
 def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: float,
             drive: Union[str, "object", None] = None, drive_params: Optional[dict] = None,
@@ -110,8 +116,8 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
                                     check_every, controller, engine, max_steps, target, wave, error_model,
                                     stop_when_periodic)
     eng, engine_reason = choose(engine, scene, drv, controller)
-    p = plan(eng, engine_reason, [wave], [drv], [eng.part(scene, drv)], duration, scene.timestep, sample_interval,
-             _meta(scene, drv, wave, duration, initial_curvature), max_steps=max_steps)
+    p = plan(eng, engine_reason, [wave], [drv], lambda: [eng.part(scene, drv)], duration, scene.timestep,
+             sample_interval, _meta(scene, drv, wave, duration, initial_curvature), max_steps=max_steps)
     (samples,) = p.samples
     if stop_when_periodic is not None:
         samples.stop = PeriodicStop(period, stop_tol, scene.layout.length)
@@ -124,12 +130,6 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
                                                controller=controller, meta=p.meta),
                    lambda error: samples.result(drv, initial_curvature, p.meta),
                    lambda result, error: write_run(result, scene, rrd, csv_path, error))
-
-
-#: the warning of a run whose straight beam is unstable under gravity ({} the actuator)
-BUCKLED = ("{}: the straight beam is unstable under gravity (the payload is above the column load): the run starts "
-           "from that unstable equilibrium and only a disturbance (an initial curvature, a voltage) makes it buckle; "
-           "a result near zero here is not a stable beam")
 
 
 def _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, csv_path, sample_interval,
@@ -224,9 +224,8 @@ def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable
     drives = [make_drive(drive, scene, **(drive_params or {})) for _ in voltages]
     eng, engine_reason = choose(engine, scene, drives[0], None, batched=True)
     waves = [to_waveform(v, duration) for v in voltages]
-    part = eng.part(scene, drives[0])
-    p = plan(eng, engine_reason, waves, drives, [part] * len(voltages), duration, scene.timestep, sample_interval,
-             {"batch": len(voltages), "nthread": nthread})
+    p = plan(eng, engine_reason, waves, drives, lambda: [eng.part(scene, drives[0])] * len(voltages), duration,
+             scene.timestep, sample_interval, {"batch": len(voltages), "nthread": nthread})
     return execute(p.meta, lambda: run_checked(eng, scene, drives, p.v_steps, list(kappa0), p.sample_steps,
                                                p.samples, nthread=nthread),
                    lambda error: None if error is not None else
