@@ -1,7 +1,9 @@
 """Headless rollouts: a scene, a drive and a voltage waveform, on one of the engines of
 :mod:`mjeap.engines` (``auto``: native where the drive has a native form, else threaded
 where it is open-loop, else the Python loop; all give the same trajectory, tested to
-round-off). The waveform is evaluated for all steps up front (vectorised).
+round-off). The waveform is evaluated for all steps up front (vectorised). :func:`rollout`
+and :func:`rollout_batch` are front ends of the one run pipeline,
+:mod:`mjeap.simulation.pipeline` (as is :meth:`mjeap.System.rollout`).
 """
 from __future__ import annotations
 
