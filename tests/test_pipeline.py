@@ -73,3 +73,33 @@ def test_a_decision_ends_the_run_as_a_result_and_an_error_is_recorded_then_raise
     with pytest.raises(ZeroDivisionError):
         pipeline.execute(meta, lambda: 1 / 0, lambda error: "partial", lambda r, e: written.append((r, type(e))))
     assert meta["error"].startswith("ZeroDivisionError") and written == [("partial", ZeroDivisionError)]
+
+
+def test_builders_state_capabilities_and_each_engine_words_its_refusal():
+    """The model layer says what a beam's model is (capabilities in model terms) and carries
+    no 'why not' per engine or feature above it; each engine words its own refusal."""
+    from mjeap.engines.native import why_not as native_why_not
+    from mjeap.engines.threaded import why_not as threaded_why_not
+    from mjeap.model.mjcf import BUILDERS, CAPABILITIES, FIXED_BENDING_FORCES, HINGE_TENDON, BeamBuilder
+    per_feature = [n for n in vars(BeamBuilder) if n.endswith("_reason") and
+                   n not in ("unavailable_reason", "layout_reason", "integrator_reason")]
+    assert not per_feature
+    for rep, builder in BUILDERS.items():
+        for capability in CAPABILITIES:
+            assert builder.has(capability) == (builder.lacks(capability) is None)
+            if not builder.has(capability):
+                assert builder.instead[capability], (rep, capability)         # said in model terms
+    assert BUILDERS["hinge"].lacks("a kernel on the GPU")           # what a builder does not state it lacks
+
+    class Tendonless(type(BUILDERS["hinge"])):
+        capabilities = frozenset({FIXED_BENDING_FORCES})
+        instead = {HINGE_TENDON: "its hinges are gears"}
+
+    class Stand:
+        builder = Tendonless()
+        part = type("Part", (), {"has_tip_load": lambda self: False})()
+    drive = type("Drive", (), {"name": "x", "native_reason": lambda self: None,
+                               "closed_loop_reason": lambda self: None})()
+    assert native_why_not(Stand(), drive).endswith("its hinges are gears")
+    assert "fixed tendon" in native_why_not(Stand(), drive)                       # the engine's own words
+    assert threaded_why_not(Stand(), drive) is None
