@@ -74,6 +74,7 @@ from typing import List, Optional
 import numpy as np
 
 from ..errors import ParameterError
+from ..model.mjcf import HINGE_CHAIN_ERROR
 
 __all__ = ["QUANTITY", "ACCURACY_RANGE", "Model", "ErrorModel", "check_accuracy", "target_for", "relative_difference",
            "calibrate", "choose_model", "run_at_accuracy", "estimate_error", "as_error_model", "fewer_segments",
@@ -367,8 +368,10 @@ def run_at_accuracy(scene, run, *, accuracy: float, duration: float, wave=None,
     model, report dict), the report also put in each result's ``meta['accuracy']``."""
     target = check_accuracy(accuracy)
     given = None if error_model is None else as_error_model(error_model)
-    if scene.builder.accuracy_reason is not None:
-        raise ParameterError("accuracy", accuracy, scene.builder.accuracy_reason)
+    lack = scene.builder.lacks(HINGE_CHAIN_ERROR)
+    if lack is not None:
+        raise ParameterError("accuracy", accuracy, f"no target on a '{scene.representation}' scene (give segments "
+                             "and timestep): the accuracy model is the hinge chain's (order 2 in segments)", lack)
     t0 = _time.perf_counter()
     grid = _grid(duration, sample_interval)
     h_cap = _step_cap(scene, wave, grid)
