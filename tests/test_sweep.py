@@ -77,8 +77,10 @@ def test_bad_sweep_input():
 @pytest.mark.slow
 def test_at_a_target_a_family_shares_its_first_points_error_model(tmp_path, monkeypatch):
     """Points differing only in load sizes (amplitude here) start from the first one's error
-    model: the others are handed the (a, b) the first ran with and run no pilots (the row
-    says so); another actuator is another family. Each point's estimated error is measured
+    model: the others are handed the (a, b) the first ran with (the row says 'shared error
+    model'; a target on the metric peak_to_peak chooses the first point's model with no prior,
+    mjeap.simulation.metric_accuracy, and so does every point without sharing); another
+    actuator is another family. Each point's estimated error is measured
     on it and meets the target, and its peak-to-peak agrees with pilots per point within
     what the two targets allow."""
     import mjeap.sweep.runner as sw
@@ -108,8 +110,8 @@ def test_at_a_target_a_family_shares_its_first_points_error_model(tmp_path, monk
     assert [c[1] for c in calls[1:3]] == [lead[2], lead[2]]          # the others got the lead's (a, b)
     assert all(c[1] is None for c in calls[3:])                         # pilots per point
     shared = [r["estimated_error"] for r in rows[True]]
-    assert sum("shared error model" in e for e in shared) == 2 and "pilots" in shared[0]
-    assert all("pilots" in r["estimated_error"] for r in rows[False])
+    assert sum("shared error model" in e for e in shared) == 2 and "no prior" in shared[0]
+    assert all("no prior" in r["estimated_error"] for r in rows[False])
     for a, b in zip(rows[True], rows[False]):
         assert float(a["estimated_error"].split()[0]) <= 1e-3 and float(b["estimated_error"].split()[0]) <= 1e-3
         # each run's curvature within 1e-3 of the swing: each peak-to-peak within 2 x that, the two within 4 x
