@@ -49,13 +49,16 @@ import time as _time
 from dataclasses import asdict
 from typing import Dict, List, Optional, Sequence
 
+import mujoco
 import numpy as np
+from mujoco import rollout as mj_rollout
 
 from ..errors import ParameterError
 from .accuracy import SAFETY, ErrorModel, Model, as_error_model, check_accuracy, choose_model, fewer_segments
 
 __all__ = ["METRIC_SCALES", "check_metrics", "answerable", "relaxed_step_cap", "last_period",
-           "peak_to_peak", "returns_margin", "metric_quantity", "metric_scale", "run_metrics_at_accuracy"]
+           "peak_to_peak", "returns_margin", "metric_quantity", "metric_scale", "run_metrics_at_accuracy",
+           "chain_kinematics", "run_from_states"]
 
 #: the metrics a target may be put on, and the scale each one's error is relative to
 METRIC_SCALES = {"peak_to_peak": "swing", "returns": "margin", "max_stress_proxy": "value",
@@ -210,6 +213,97 @@ def _relative(x: float, scale: float) -> float:
     return x / scale if scale > 0 else (0.0 if x == 0 else math.inf)
 
 
+# ---------------------------------------------------------------- a run read from its states
+def _hinge_rotations(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
+    """(n, 3, 3) rotations by ``angle`` (n,) rad about the unit ``axis`` (Rodrigues)."""
+    k = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    s, c = np.sin(angle)[:, None, None], np.cos(angle)[:, None, None]
+    return np.eye(3) + s * k + (1.0 - c) * (k @ k)
+
+
+def chain_kinematics(model, qpos: np.ndarray, bodies: Sequence[int]):
+    """World positions (n, B, 3) and orientations (n, B, 3, 3) of ``bodies`` for the joint
+    positions ``qpos`` (n, nq), computed for all samples at once down the kinematic tree;
+    None where a body on the way moves by anything but one hinge through its origin."""
+    last = max(bodies)
+    n = len(qpos)
+    xpos = np.zeros((last + 1, n, 3))
+    xmat = np.empty((last + 1, n, 3, 3))
+    xmat[0] = np.eye(3)
+    for b in range(1, last + 1):
+        p, nj = model.body_parentid[b], model.body_jntnum[b]
+        local = np.empty(9)
+        mujoco.mju_quat2Mat(local, model.body_quat[b])
+        rot = np.broadcast_to(local.reshape(3, 3), (n, 3, 3))
+        if nj:
+            j = model.body_jntadr[b]
+            if nj > 1 or model.jnt_type[j] != mujoco.mjtJoint.mjJNT_HINGE or np.any(model.jnt_pos[j]):
+                return None
+            rot = rot @ _hinge_rotations(model.jnt_axis[j], qpos[:, model.jnt_qposadr[j]])
+        xpos[b] = xpos[p] + xmat[p] @ model.body_pos[b]
+        xmat[b] = xmat[p] @ rot
+    idx = np.asarray(bodies)
+    return xpos[idx].transpose(1, 0, 2), xmat[idx].transpose(1, 0, 2, 3)
+
+
+def run_from_states(scene, drive, wave, duration: float, initial_curvature: float = 0.0):
+    """One native run of ``scene`` sampled at every step, its samples read from the states
+    ``mujoco.rollout`` returns (one call, no Python per step; the beam's points by
+    :func:`chain_kinematics`, the drive's signals by its ``native_signal_history``): the
+    RolloutResult the native engine gives sampled every step, at a fraction of the cost. None
+    where that does not apply (no native form, a moving clamp, tip loads, a drive reading
+    its signals one sample at a time, joints other than hinges) or where the run goes bad
+    (the caller then runs it the ordinary way, which says why)."""
+    from ..engines.frame import Samples, voltage_steps
+    from ..engines.native import why_not
+    from ..drives.base import NativeForm
+    from ..engines.threaded import MAXVAL, NATIVE_CONTROL, STATE
+    from ..io.outputs import provenance
+    if why_not(scene, drive) is not None or scene.part.has_tip_load() or \
+            type(drive).native_signal_history is NativeForm.native_signal_history:
+        return None
+    native = scene.native_model(drive)
+    m, d, part = native.model, native.data, native.part
+    dt = scene.timestep
+    v = voltage_steps(wave, duration, dt, drive)
+    n = len(v)
+    native.reset(initial_curvature)
+    state0 = np.empty(mujoco.mj_stateSize(m, STATE))
+    mujoco.mj_getState(m, d, state0, STATE)
+    control = np.empty(mujoco.mj_stateSize(m, NATIVE_CONTROL))
+    mujoco.mj_getState(m, d, control, NATIVE_CONTROL)
+    drive.native_prepare(v)
+    ctl = np.broadcast_to(control, (1, n, len(control))).copy()
+    ctl[0, :, native.actuator_id] = v
+    states, _ = mj_rollout.rollout(m, d, state0[None], ctl, control_spec=NATIVE_CONTROL, nstep=n)
+    # bad: not finite or beyond mjMAXVAL, or a step on which MuJoCo warned (time stops)
+    if not (np.abs(states[0, :, 1:]) < MAXVAL).all() or not (np.diff(states[0, :, 0]) > 0).all() or \
+            d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number:
+        return None
+    rows = np.concatenate([state0[None], states[0]])
+    steps = np.arange(n + 1)
+    drive.part = part
+    try:
+        sig = drive.native_signal_history(steps, rows, part, native.handles)
+    finally:
+        drive.part = scene.part
+    bodies = [part.clamp_id, *part.link_ids, part.tip_body_id] + ([part.payload_id] if part.payload_id >= 0 else [])
+    kin = chain_kinematics(m, rows[:, 1:1 + m.nq], bodies)
+    if sig is None or kin is None:
+        return None
+    pos, rot = kin
+    N = len(part.link_ids)
+    site = pos[:, N + 1] + rot[:, N + 1] @ m.site_pos[part.tip_site_id]
+    raw = np.concatenate([pos[:, :N + 1], site[:, None]] + ([pos[:, N + 2:]] if part.payload_id >= 0 else []), axis=1)
+    samples = Samples(part, n + 1)
+    samples.take_all(steps * dt, np.r_[v[0], v], raw, rot[:, N + 1].reshape(-1, 9), sig)
+    meta = {**provenance(), "actuator": scene.actuator.id, "drive": drive.describe(),
+            "voltage": getattr(wave, "text", str(wave)), "duration_s": duration,
+            "initial_curvature_per_m": initial_curvature, "steps": n,
+            "engine": "native (every step read from mujoco.rollout's states)", "scene": scene.summary()}
+    return samples.result(drive, initial_curvature, meta)
+
+
 # ---------------------------------------------------------------- the choice
 def _cost(model: Model, duration: float) -> float:
     c0, c1 = COST_PER_STEP
@@ -280,11 +374,13 @@ def _needs(metrics: Dict[str, dict], target: float) -> float:
 
 
 def run_metrics_at_accuracy(scene, run, *, metrics: Sequence[str], accuracy: float, duration: float, drive,
-                            wave=None, sample_interval: Optional[float] = None, error_model=None):
+                            wave=None, sample_interval: Optional[float] = None, error_model=None, every_step=None):
     """Choose, run and check a model of ``scene`` whose ``metrics`` (names of
     :data:`METRIC_SCALES`) are within ``accuracy`` of their scales. ``run(scene, interval)``
     runs one model sampled every ``interval`` s (None: every step) and returns a
-    RolloutResult; ``drive`` (the question's drive) bounds the relaxed step. ``error_model``:
+    RolloutResult; ``every_step(scene)``, where given, runs one sampled every step the faster
+    way (:func:`run_from_states`; None where that does not apply: ``run`` then runs it);
+    ``drive`` (the question's drive) bounds the relaxed step. ``error_model``:
     (a, b) of a similar question (a sweep's earlier point) choosing the first model. Returns
     (result, scene of the chosen model, report), the report also in
     ``result.meta['accuracy']`` with one entry per metric under ``'metrics'``."""
@@ -311,7 +407,9 @@ def run_metrics_at_accuracy(scene, run, *, metrics: Sequence[str], accuracy: flo
     def one(model: Model, role: str, interval=None):
         s = scene.variant(model.segments, model.timestep, model.integrator)
         t = _time.perf_counter()
-        out = run(s, interval)
+        out = every_step(s) if every_step is not None and interval == model.timestep else None
+        if out is None:
+            out = run(s, interval)
         log.append({"role": role, **asdict(model), "wall_time_s": _time.perf_counter() - t})
         return s, out
 

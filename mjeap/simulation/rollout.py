@@ -177,10 +177,14 @@ def _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, 
                        stop_when_periodic=stop)
 
     if target is not None and metrics:
-        from .metric_accuracy import run_metrics_at_accuracy
+        from .metric_accuracy import run_from_states, run_metrics_at_accuracy
+        every_step = None       # each run sampled every step, read from its states where that applies
+        if controller is None and engine in ("auto", "native") and stop_when_periodic is None and max_steps is None:
+            def every_step(s):
+                return run_from_states(s, type(drv)(s, **params), wave, duration, initial_curvature)
         result, chosen, _ = run_metrics_at_accuracy(scene, run, metrics=metrics, accuracy=target, duration=duration,
                                                     drive=drv, wave=wave, sample_interval=sample_interval,
-                                                    error_model=error_model)
+                                                    error_model=error_model, every_step=every_step)
     elif target is None:
         chosen = scene
         result = run(scene, sample_interval)
