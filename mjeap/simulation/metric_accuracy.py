@@ -87,8 +87,8 @@ STEP_RICHARDSON = 1.0
 MAX_REFINEMENTS = 3
 #: cost of a run of a model: RUN_OVERHEAD + steps x (c0 + c1 N) (us; this 2-core machine,
 #: the map's scene: building a variant and a rollout's set-up cost about 25 ms)
-RUN_OVERHEAD_US = 25_000.0
-COST_PER_STEP = (3.0, 0.6)
+RUN_OVERHEAD_US = 15_000.0
+COST_PER_STEP = (1.0, 1.6)
 #: a model is never chosen with more steps than this (a boolean at its edge falls back to
 #: the scene's own model instead)
 MAX_MODEL_STEPS = 2_000_000
@@ -223,27 +223,46 @@ def _hinge_rotations(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
 
 def chain_kinematics(model, qpos: np.ndarray, bodies: Sequence[int]):
     """World positions (n, B, 3) and orientations (n, B, 3, 3) of ``bodies`` for the joint
-    positions ``qpos`` (n, nq), computed for all samples at once down the kinematic tree;
-    None where a body on the way moves by anything but one hinge through its origin."""
-    last = max(bodies)
+    positions ``qpos`` (n, nq), all samples at once, down a planar chain: each body's frame
+    is a fixed rotation F times a rotation by the summed angle phi of the hinges above it
+    about their one axis, so a point v of a body sits at x + F (v cos phi + (a x v) sin phi
+    + a (a . v)(1 - cos phi)). None where a body moves otherwise (a joint other than one
+    hinge through its origin, hinges on different axes, a rotated body below a hinge)."""
     n = len(qpos)
-    xpos = np.zeros((last + 1, n, 3))
-    xmat = np.empty((last + 1, n, 3, 3))
-    xmat[0] = np.eye(3)
-    for b in range(1, last + 1):
+    frame = [(np.eye(3), None, None)]           # per body: F, axis a, phi (n,) (None: not rotating)
+    xpos = [np.zeros((1, 3))]
+    for b in range(1, max(bodies) + 1):
         p, nj = model.body_parentid[b], model.body_jntnum[b]
+        f, a, phi = frame[p]
+        v = model.body_pos[b]
+        if phi is None:
+            xpos.append(xpos[p] + f @ v)
+        else:
+            c, sn = np.cos(phi)[:, None], np.sin(phi)[:, None]
+            xpos.append(xpos[p] + c * (f @ v) + sn * (f @ np.cross(a, v)) + (1 - c) * (f @ a) * (a @ v))
         local = np.empty(9)
         mujoco.mju_quat2Mat(local, model.body_quat[b])
-        rot = np.broadcast_to(local.reshape(3, 3), (n, 3, 3))
+        local = local.reshape(3, 3)
+        if nj > 1:
+            return None
         if nj:
             j = model.body_jntadr[b]
-            if nj > 1 or model.jnt_type[j] != mujoco.mjtJoint.mjJNT_HINGE or np.any(model.jnt_pos[j]):
+            if model.jnt_type[j] != mujoco.mjtJoint.mjJNT_HINGE or np.any(model.jnt_pos[j]):
                 return None
-            rot = rot @ _hinge_rotations(model.jnt_axis[j], qpos[:, model.jnt_qposadr[j]])
-        xpos[b] = xpos[p] + xmat[p] @ model.body_pos[b]
-        xmat[b] = xmat[p] @ rot
-    idx = np.asarray(bodies)
-    return xpos[idx].transpose(1, 0, 2), xmat[idx].transpose(1, 0, 2, 3)
+        if phi is not None and (not np.allclose(local, np.eye(3), rtol=0, atol=1e-15) or
+                                (nj and not np.array_equal(model.jnt_axis[model.body_jntadr[b]], a))):
+            return None
+        if not nj:
+            frame.append((f @ local, None, None) if phi is None else (f, a, phi))
+            continue
+        j = model.body_jntadr[b]
+        q = qpos[:, model.jnt_qposadr[j]]
+        frame.append((f @ local, model.jnt_axis[j].copy(), q) if phi is None else (f, a, phi + q))
+    pos = np.stack([np.broadcast_to(xpos[b], (n, 3)) for b in bodies], axis=1)
+    rot = np.stack([np.broadcast_to(frame[b][0], (n, 3, 3)) if frame[b][2] is None else
+                    np.einsum("ij,njk->nik", frame[b][0], _hinge_rotations(frame[b][1], frame[b][2]))
+                    for b in bodies], axis=1)
+    return pos, rot
 
 
 def run_from_states(scene, drive, wave, duration: float, initial_curvature: float = 0.0):
@@ -403,28 +422,55 @@ def run_metrics_at_accuracy(scene, run, *, metrics: Sequence[str], accuracy: flo
     grid = period / SAMPLES_PER_PERIOD if own_grid else (sample_interval or duration)
     h_cap = min(h_cap, grid)
     log: List[dict] = []
+    done: Dict[tuple, tuple] = {}        # (model, interval) -> (scene, result): a refinement's companions reuse them
 
     def one(model: Model, role: str, interval=None):
+        if (model, interval) in done:
+            log.append({"role": role + " (reused)", **asdict(model), "wall_time_s": 0.0})
+            return done[model, interval]
         s = scene.variant(model.segments, model.timestep, model.integrator)
         t = _time.perf_counter()
         out = every_step(s) if every_step is not None and interval == model.timestep else None
         if out is None:
             out = run(s, interval)
         log.append({"role": role, **asdict(model), "wall_time_s": _time.perf_counter() - t})
+        done[model, interval] = s, out
         return s, out
 
-    def attempt(model: Model, role: str):
-        chosen, f = one(model, role, sample_interval or model.timestep)
-        n_s = fewer_segments(model.segments)
+    def runs_of(model: Model) -> list:
+        """The runs an attempt at ``model`` needs: it and its two companions."""
         h2 = 2 * model.timestep
-        every = sample_interval or h2
-        _, mid = one(Model(model.segments, h2, model.integrator), "companion", every)
-        _, fewer = one(Model(n_s, h2, model.integrator), "spatial companion", every)
-        return chosen, f, _evaluate(names, ((f, mid, fewer), (model.segments, n_s)), period, duration,
+        return [(model, sample_interval or model.timestep),
+                (Model(model.segments, h2, model.integrator), sample_interval or h2),
+                (Model(fewer_segments(model.segments), h2, model.integrator), sample_interval or h2)]
+
+    def new_cost(model: Model) -> float:
+        """The cost of an attempt at ``model``, less the runs already done."""
+        return sum(_cost(m, duration) for m, i in runs_of(model) if (m, i) not in done)
+
+    def refine(em: ErrorModel, need: float, last: Model) -> Model:
+        """The cheapest next model by the error model: :func:`_choose`'s, or ``last``'s
+        segments at an integer fraction of its step (its runs then serve as companions)."""
+        best = _choose(scene, em, need, duration, grid, h_cap)
+        for k in (2, 3, 4, 6, 8):
+            m = Model(last.segments, last.timestep / k, last.integrator)
+            if em.predict(m) <= need / SAFETY and _integrator(scene, m.timestep) == last.integrator and \
+                    new_cost(m) < new_cost(best):
+                best = m
+        return best
+
+    def attempt(model: Model, role: str):
+        (m_f, i_f), (m_mid, i_mid), (m_s, i_s) = runs_of(model)
+        chosen, f = one(m_f, role, i_f)
+        _, mid = one(m_mid, "companion", i_mid)
+        _, fewer = one(m_s, "spatial companion", i_s)
+        return chosen, f, _evaluate(names, ((f, mid, fewer), (model.segments, m_s.segments)), period, duration,
                                     model.timestep)
 
-    if given is not None:
+    if given is not None:       # not below START_SEGMENTS: a family's first point (its lightest load, on the
+        # map) predicts too few for the rest (from 4 segments 13 of the map's 23 other points were refined)
         model = _choose(scene, given, target, duration, grid, h_cap)
+        model = Model(max(model.segments, START_SEGMENTS), model.timestep, model.integrator)
     else:
         h0 = _on_grid(h_cap, grid / 2)
         model = Model(START_SEGMENTS, h0, _integrator(scene, h0))
@@ -435,7 +481,7 @@ def run_metrics_at_accuracy(scene, run, *, metrics: Sequence[str], accuracy: flo
     while need > 0 and refinements < MAX_REFINEMENTS:
         em = ErrorModel(max(max(m["segments_error"] for m in found.values()) * model.segments ** 2, 1e-12),
                         max(max(m["step_error"] for m in found.values()) / model.timestep, 1e-12))
-        nxt = _choose(scene, em, need, duration, grid, h_cap)
+        nxt = refine(em, need, model)
         if duration / nxt.timestep > MAX_MODEL_STEPS or \
                 (nxt.segments <= model.segments and nxt.timestep >= model.timestep):
             break
