@@ -278,9 +278,11 @@ def run_from_states(scene, drive, wave, duration: float, initial_curvature: floa
     from ..drives.base import NativeForm
     from ..engines.threaded import MAXVAL, NATIVE_CONTROL, STATE
     from ..io.outputs import provenance
+    from .rollout import warn_if_buckled
     if why_not(scene, drive) is not None or scene.part.has_tip_load() or \
             type(drive).native_signal_history is NativeForm.native_signal_history:
         return None
+    t0 = _time.perf_counter()
     native = scene.native_model(drive)
     m, d, part = native.model, native.data, native.part
     dt = scene.timestep
@@ -319,7 +321,9 @@ def run_from_states(scene, drive, wave, duration: float, initial_curvature: floa
     meta = {**provenance(), "actuator": scene.actuator.id, "drive": drive.describe(),
             "voltage": getattr(wave, "text", str(wave)), "duration_s": duration,
             "initial_curvature_per_m": initial_curvature, "steps": n,
-            "engine": "native (every step read from mujoco.rollout's states)", "scene": scene.summary()}
+            "engine": "native (every step read from mujoco.rollout's states)", "scene": scene.summary(),
+            "wall_time_s": _time.perf_counter() - t0}
+    warn_if_buckled(scene, meta)
     return samples.result(drive, initial_curvature, meta)
 
 
