@@ -278,7 +278,6 @@ def run_from_states(scene, drive, wave, duration: float, initial_curvature: floa
     from ..drives.base import NativeForm
     from ..engines.threaded import MAXVAL, NATIVE_CONTROL, STATE
     from ..io.outputs import provenance
-    from .rollout import warn_if_buckled
     if why_not(scene, drive) is not None or scene.part.has_tip_load() or \
             type(drive).native_signal_history is NativeForm.native_signal_history:
         return None
@@ -323,7 +322,8 @@ def run_from_states(scene, drive, wave, duration: float, initial_curvature: floa
             "initial_curvature_per_m": initial_curvature, "steps": n,
             "engine": "native (every step read from mujoco.rollout's states)", "scene": scene.summary(),
             "wall_time_s": _time.perf_counter() - t0}
-    warn_if_buckled(scene, meta)
+    if scene.choice.buckled:
+        meta["warnings"] = [scene.buckled_warning()]
     return samples.result(drive, initial_curvature, meta)
 
 

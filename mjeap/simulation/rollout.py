@@ -44,15 +44,6 @@ def _meta(scene, drv, wave, duration, initial_curvature, n_steps, engine) -> dic
             "drive_parameters": {k: [v, drv.sources.get(k, "")] for k, v in drv.params.items()}}
 
 
-def warn_if_buckled(scene, meta: dict) -> None:
-    """A run's warning, in ``meta``, where the scene's straight beam is unstable under gravity."""
-    if scene.choice.buckled:
-        meta.setdefault("warnings", []).append(
-            f"{scene.actuator.id}: the straight beam is unstable under gravity (the payload is above the column "
-            "load): the run starts from that unstable equilibrium and only a disturbance (an initial curvature, a "
-            "voltage) makes it buckle; a result near zero here is not a stable beam")
-
-
 @guarded("rrd", "csv_path")
 def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: float,
             drive: Union[str, "object", None] = None, drive_params: Optional[dict] = None,
@@ -133,7 +124,8 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
         samples.stop = PeriodicStop(period, stop_tol, scene.layout.length)
     meta = _meta(scene, drv, wave, duration, initial_curvature, n_steps, eng.name)
     meta["engine_reason"] = engine_reason
-    warn_if_buckled(scene, meta)
+    if scene.choice.buckled:
+        meta.setdefault("warnings", []).append(scene.buckled_warning())
     if controller is not None:
         meta["controller"] = ctrl_name
     error = None
