@@ -221,8 +221,8 @@ def _hinge_rotations(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
     return np.eye(3) + s * k + (1.0 - c) * (k @ k)
 
 
-def chain_kinematics(model, qpos: np.ndarray, bodies: Sequence[int]):
-    """World positions (n, B, 3) and orientations (n, B, 3, 3) of ``bodies`` for the joint
+def chain_kinematics(model, qpos: np.ndarray, bodies: Sequence[int], frame_of: int):
+    """World positions (n, B, 3) of ``bodies`` and orientation (n, 3, 3) of body ``frame_of`` for the joint
     positions ``qpos`` (n, nq), all samples at once, down a planar chain: each body's frame
     is a fixed rotation F times a rotation by the summed angle phi of the hinges above it
     about their one axis, so a point v of a body sits at x + F (v cos phi + (a x v) sin phi
@@ -231,7 +231,7 @@ def chain_kinematics(model, qpos: np.ndarray, bodies: Sequence[int]):
     n = len(qpos)
     frame = [(np.eye(3), None, None)]           # per body: F, axis a, phi (n,) (None: not rotating)
     xpos = [np.zeros((1, 3))]
-    for b in range(1, max(bodies) + 1):
+    for b in range(1, max(*bodies, frame_of) + 1):
         p, nj = model.body_parentid[b], model.body_jntnum[b]
         f, a, phi = frame[p]
         v = model.body_pos[b]
@@ -259,10 +259,8 @@ def chain_kinematics(model, qpos: np.ndarray, bodies: Sequence[int]):
         q = qpos[:, model.jnt_qposadr[j]]
         frame.append((f @ local, model.jnt_axis[j].copy(), q) if phi is None else (f, a, phi + q))
     pos = np.stack([np.broadcast_to(xpos[b], (n, 3)) for b in bodies], axis=1)
-    rot = np.stack([np.broadcast_to(frame[b][0], (n, 3, 3)) if frame[b][2] is None else
-                    np.einsum("ij,njk->nik", frame[b][0], _hinge_rotations(frame[b][1], frame[b][2]))
-                    for b in bodies], axis=1)
-    return pos, rot
+    f, a, phi = frame[frame_of]
+    return pos, np.broadcast_to(f, (n, 3, 3)) if phi is None else f @ _hinge_rotations(a, phi)
 
 
 def run_from_states(scene, drive, wave, duration: float, initial_curvature: float = 0.0):
@@ -308,15 +306,15 @@ def run_from_states(scene, drive, wave, duration: float, initial_curvature: floa
     finally:
         drive.part = scene.part
     bodies = [part.clamp_id, *part.link_ids, part.tip_body_id] + ([part.payload_id] if part.payload_id >= 0 else [])
-    kin = chain_kinematics(m, rows[:, 1:1 + m.nq], bodies)
+    kin = chain_kinematics(m, rows[:, 1:1 + m.nq], bodies, part.tip_body_id)
     if sig is None or kin is None:
         return None
     pos, rot = kin
     N = len(part.link_ids)
-    site = pos[:, N + 1] + rot[:, N + 1] @ m.site_pos[part.tip_site_id]
+    site = pos[:, N + 1] + rot @ m.site_pos[part.tip_site_id]
     raw = np.concatenate([pos[:, :N + 1], site[:, None]] + ([pos[:, N + 2:]] if part.payload_id >= 0 else []), axis=1)
     samples = Samples(part, n + 1)
-    samples.take_all(steps * dt, np.r_[v[0], v], raw, rot[:, N + 1].reshape(-1, 9), sig)
+    samples.take_all(steps * dt, np.r_[v[0], v], raw, rot.reshape(-1, 9), sig)
     meta = {**provenance(), "actuator": scene.actuator.id, "drive": drive.describe(),
             "voltage": getattr(wave, "text", str(wave)), "duration_s": duration,
             "initial_curvature_per_m": initial_curvature, "steps": n,
