@@ -38,7 +38,10 @@ sampled coarser than its step (a user's interval) the sampling's, |q(F) - q(F ev
 sample)| / 3, combined in quadrature. Each run is sampled every step otherwise: the drive
 held over a step puts a square wave's peak one step after its switch, and a grid coarser
 than the step reads the models' peaks unequally (on thick-trilayer's length sweep that hid
-a 0.7 % error from the companions). Where a metric's estimate exceeds the target (or a boolean is undecided), the
+a 0.7 % error from the companions); such a run is read from the states ``mujoco.rollout``
+returns for all its steps (:func:`run_from_states`), not sampled from Python, and a
+refinement reuses the runs already made (its 2 h companion is the last chosen run where it
+halves the step). Where a metric's estimate exceeds the target (or a boolean is undecided), the
 error model e = sqrt((a / N^2)^2 + (b h)^2) takes a and b from the measured parts and a finer
 model is run. Measured numbers: docs/concepts/accuracy.md, scripts/bench.py.
 """
@@ -86,7 +89,8 @@ START_SEGMENTS = 8
 STEP_RICHARDSON = 1.0
 MAX_REFINEMENTS = 3
 #: cost of a run of a model: RUN_OVERHEAD + steps x (c0 + c1 N) (us; this 2-core machine,
-#: the map's scene: building a variant and a rollout's set-up cost about 25 ms)
+#: the map's scene under 'discrete', read from its states (:func:`run_from_states`): building
+#: a variant and its native model about 12 ms, a step of 8 segments 12-15 us, of 16 27-35 us)
 RUN_OVERHEAD_US = 15_000.0
 COST_PER_STEP = (1.0, 1.6)
 #: a model is never chosen with more steps than this (a boolean at its edge falls back to
