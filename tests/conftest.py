@@ -9,14 +9,14 @@ import pytest  # noqa: E402
 #: the package are tests/test_layers.py's; ``contracts`` holds the failure-behaviour classes that
 #: cut across them. tests/test_docs.py checks that every test file is here and in the docs' table.
 LAYER_FILES = {
-    "foundation": ("test_layers", "test_errors", "test_units", "test_versions", "test_docs"),
+    "foundation": ("test_layers", "test_encapsulation", "test_errors", "test_units", "test_versions", "test_docs"),
     "io": ("test_output_paths", "test_output_safety", "test_recordings"),
     "model": ("test_section", "test_analytical", "test_lti", "test_statics", "test_dynamics", "test_axial",
               "test_rod", "test_assets", "test_actuator_files"),
     "drives": ("test_drive_ionic", "test_drive_electrostatic", "test_drive_allocation", "test_piezo_moment",
                "test_piezo_power", "test_pvdf_fidelity"),
     "engines": ("test_threaded", "test_native", "test_warp"),
-    "simulation": ("test_rollout", "test_system", "test_accuracy", "test_periodic", "test_golden",
+    "simulation": ("test_rollout", "test_system", "test_pipeline", "test_accuracy", "test_periodic", "test_golden",
                    "test_viewer"),
     "analysis": ("test_identify", "test_self_sensing", "test_stability_map"),
     "applications": ("test_sweep", "test_metric_accuracy", "test_design_sweeps", "test_optimize", "test_actuator_cli",

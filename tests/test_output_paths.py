@@ -179,11 +179,11 @@ def _enospc_after(monkeypatch, module, nbytes):
 
 @pytest.mark.parametrize("which", ["rrd", "csv_path"])
 def test_a_full_disk_leaves_the_old_file_and_no_temporary(tmp_path, monkeypatch, which):
-    from mjeap.engines import frame
+    from mjeap.engines import result          # RolloutResult.to_csv writes the CSV
     from mjeap.io import recording
     old = tmp_path / ("r.rrd" if which == "rrd" else "r.csv")
     old.write_bytes(b"the old file")
-    _enospc_after(monkeypatch, recording if which == "rrd" else frame, 2000)
+    _enospc_after(monkeypatch, recording if which == "rrd" else result, 2000)
     with pytest.raises(OutputError, match="No space left on device") as e:
         _run(**{which: old})
     assert e.value.result is not None                       # the finished run rides along

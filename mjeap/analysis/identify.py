@@ -338,7 +338,7 @@ def _scene_like(scene, act, **kw):
     """A Scene of ``act`` built as ``scene`` is (representation, segments, orientation,
     payload, units, gravity, integrator), ``kw`` over it."""
     from ..simulation.scene import Scene
-    a = scene._arguments
+    a = scene.arguments
     args = dict(representation=a["representation"], segments=scene.layout.segments, orientation=a["orientation"],
                 payload=a["payload"], units=a["units"], gravity=a["gravity"], integrator=scene.integrator)
     return Scene(act, **{**args, **kw})

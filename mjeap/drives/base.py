@@ -413,7 +413,7 @@ class ReadOnlyPart:
 
     def __init__(self, part):
         self._part = part
-        self._stiffness_scale = getattr(part, "_stiffness_scale", 1.0)
+        self.stiffness_scale = getattr(part, "stiffness_scale", 1.0)
 
     def __getattr__(self, name):
         return getattr(self._part, name)
@@ -422,4 +422,4 @@ class ReadOnlyPart:
         pass
 
     def set_bending_stiffness_scale(self, scale) -> None:
-        self._stiffness_scale = scale
+        self.stiffness_scale = scale

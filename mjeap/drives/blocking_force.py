@@ -102,7 +102,7 @@ class BlockingForceDrive(OpenLoop, NativeForm, Drive):
 
     def signals(self) -> Dict[str, float]:
         return {"blocking_force (N)": float(self.force.x[0, 0]), "drive_moment (N m)": float(self._moment),
-                "stiffness_factor (-)": float(self.part._stiffness_scale)}
+                "stiffness_factor (-)": float(self.part.stiffness_scale)}
 
     def reference_curvature(self, t, v, initial_curvature=0.0):
         """Quasi-static: uniform curvature (2/3) F_B L / (f(V) EI), F_B the same first-order

@@ -154,7 +154,7 @@ class ElectrostrictiveDrive(OpenLoop, Drive):
 
     def signals(self) -> Dict[str, float]:
         return {"field (V/m)": float(self._E), "drive_moment (N m)": float(self._M),
-                "stiffness_factor (-)": float(self.part._stiffness_scale)}
+                "stiffness_factor (-)": float(self.part.stiffness_scale)}
 
     def reference_curvature(self, t, v, initial_curvature=0.0):
         """Quasi-static uniform curvature M(V) / (f(E) EI) of the continuum beam."""

@@ -17,7 +17,7 @@ Conventions every generated model follows: the custom numeric ``mjeap_units`` ho
 "L M T", the SI size of one internal length, mass and time unit; the beam's names are as
 a :class:`mjeap.Scene` builds them (``clamp`` body, ``tip`` site, ``hinge<j>`` joints),
 prefixed per actuator when several share a model. A representation without bending joints
-to sum has no native form (its builder's ``native_reason``: the cable's ball joints, the
+to sum has no native form (its builder lacks ``HINGE_TENDON``, :mod:`mjeap.model.mjcf`: the cable's ball joints, the
 rod's vertices) and runs on the loop (or threaded) engine.
 """
 from __future__ import annotations

@@ -26,11 +26,11 @@ from typing import Dict, List, Sequence, Tuple
 import numpy as np
 
 from ..errors import ParameterError, check_registration
-from .base import Engine
+from .base import Engine, SceneTarget, SystemTarget, Target
 from .frame import Decided
 
-__all__ = ["Engine", "register_engine", "get_engine", "engine_names", "choose", "choose_system", "stepper",
-           "run_checked", "run_system_checked", "check_samples", "ENGINES"]
+__all__ = ["Engine", "Target", "SceneTarget", "SystemTarget", "register_engine", "get_engine", "engine_names", "choose",
+           "choose_system", "stepper", "run_checked", "run_system_checked", "check_samples", "ENGINES"]
 
 
 _REGISTRY: Dict[str, Engine] = {}
@@ -80,11 +80,7 @@ def _samples_fault(smp, stopped_early: bool = False):
     n, ns = smp.n, smp.ns
     if not isinstance(n, (int, np.integer)) or not (1 <= n <= ns if stopped_early else n == ns):
         return f"it took {n!r} of the {ns} planned samples" + (" before it stopped early" if stopped_early else "")
-    points = smp._bodies.size + 1 + (smp.part.payload_id >= 0)       # clamp, links, tip[, payload]
-    arrays = {"times": (smp.t, (ns,)), "voltages": (smp.v, (ns,)), "positions": (smp._raw, (ns, points, 3)),
-              "orientations": (smp._xmat, (ns, 9))}
-    if smp._clamp_xmat is not None:
-        arrays["clamp orientations"] = (smp._clamp_xmat, (ns, 9))
+    arrays = smp.planned_arrays()
     wrong = [f"{k} of shape {np.shape(a)}, not {want}" for k, (a, want) in arrays.items() if np.shape(a) != want]
     wrong += [f"signal {k!r} of shape {np.shape(x)}, not ({n},) or longer"        # (n,): the native engine's
               for k, x in (smp.sig or {}).items() if np.ndim(x) != 1 or len(x) < n]
@@ -106,8 +102,8 @@ def check_samples(engine: Engine, samples: Sequence, stopped_early: bool = False
             raise _refuse_run(engine, (f"run {b + 1} of {len(samples)}: " if len(samples) > 1 else "") + fault)
 
 
-def run_checked(engine: Engine, scene, drives: Sequence, v_steps: Sequence, initial_curvatures: Sequence[float],
-                sample_steps, samples: Sequence, **kw) -> None:
+def run_checked(engine: Engine, scene: SceneTarget, drives: Sequence, v_steps: Sequence,
+                initial_curvatures: Sequence[float], sample_steps, samples: Sequence, **kw) -> None:
     """``engine.run(...)`` (:meth:`Engine.run`), then its samples checked (:func:`check_samples`):
     a plug-in engine that fills too few samples or non-finite ones is refused naming it,
     not returned as an empty or NaN result. A :class:`Decided` goes on up."""
@@ -119,7 +115,7 @@ def run_checked(engine: Engine, scene, drives: Sequence, v_steps: Sequence, init
     check_samples(engine, samples)
 
 
-def run_system_checked(engine: Engine, system, n_steps: int, sample_steps, before, sample, check) -> None:
+def run_system_checked(engine: Engine, system: SystemTarget, n_steps: int, sample_steps, before, sample, check) -> None:
     """``engine.run_system(...)`` (:meth:`Engine.run_system`) with its sampling checked: a
     plug-in engine that skips, repeats or reorders a planned sample is refused naming it,
     and the state is checked (``check``) at every sample, so none is non-finite."""

@@ -1,6 +1,7 @@
 """The stepping frame every engine shares (:mod:`mjeap.engines`): the run's work and
 sampling checked before it starts, the voltage history, the sample store of one actuator
-and the SI result, and :func:`lockstep`, the loop that steps a model from Python.
+(its SI result a :class:`mjeap.engines.result.RolloutResult`, re-exported here) and
+:func:`lockstep`, the loop that steps a model from Python.
 
 A sample copies MuJoCo's raw world positions and the drive's signals; the SI read-outs
 (clamp frame, tip angle, arc curvature) are computed for all samples at once at the end.
@@ -8,18 +9,15 @@ A sample copies MuJoCo's raw world positions and the drive's signals; the SI rea
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
-from pathlib import Path
-from typing import Callable, Dict, Optional, Union
+from typing import Callable, Dict, Optional
 
 import mujoco
 import numpy as np
 
-from ..io import csvio
 from ..model.analytical import arc_curvature
 from ..errors import ParameterError, check_range
-from ..io.outputs import replacing
 from ..drives.waveforms import Waveform, parse_waveform
+from .result import RolloutResult
 
 __all__ = ["RolloutResult", "Decided", "Samples", "MAX_STEPS", "DEFAULT_SAMPLES", "check_work", "check_sampling",
            "voltage_steps", "to_waveform", "one_voltage", "check_initial_curvature", "sample_steps", "lockstep",
@@ -40,44 +38,6 @@ class Decided(Exception):
         self.step, self.state = None, None
 
 
-@dataclass
-class RolloutResult:
-    """Sampled SI arrays of a rollout. Positions are in the clamp frame (x along the
-    undeformed beam, y the deflection, z out of the bending plane). Sample i is the state
-    after step k; its voltage is the one held over that step (zero-order hold), the same
-    instant the drive signals describe."""
-
-    time: np.ndarray                 # (n,) s
-    voltage: np.ndarray              # (n,) V
-    tip_position: np.ndarray         # (n, 3) m
-    tip_angle: np.ndarray            # (n,) rad
-    tip_curvature: np.ndarray        # (n,) 1/m, arc through clamp and tip (seed 000)
-    centreline: np.ndarray           # (n, N + 2, 3) m
-    payload_position: Optional[np.ndarray]
-    signals: Dict[str, np.ndarray]   # drive quantities, 'name (unit)'
-    reference_curvature: Optional[np.ndarray]
-    meta: dict = field(default_factory=dict)
-
-    def peak_to_peak(self, key: str = "tip_curvature", t_from: float = 0.0) -> float:
-        y = getattr(self, key) if hasattr(self, key) else self.signals[key]
-        sel = self.time >= t_from
-        return float(np.max(y[sel]) - np.min(y[sel]))
-
-    def to_csv(self, path: Union[str, Path]) -> None:
-        """Time series (no centreline) as CSV with SI units in the header, written whole
-        (:func:`mjeap.io.outputs.replacing`) and spreadsheet-safe (:class:`mjeap.io.csvio.writer`)."""
-        cols = {"time (s)": self.time, "voltage (V)": self.voltage,
-                "tip_x (m)": self.tip_position[:, 0], "tip_y (m)": self.tip_position[:, 1],
-                "tip_z (m)": self.tip_position[:, 2], "tip_angle (rad)": self.tip_angle,
-                "tip_curvature (1/m)": self.tip_curvature, **self.signals}
-        if self.reference_curvature is not None:
-            cols["reference_curvature (1/m)"] = self.reference_curvature
-        with replacing(path, "csv_path") as tmp, open(tmp, "w", newline="") as fh:
-            w = csvio.writer(fh)
-            w.writerow(cols)
-            w.writerows(np.column_stack([np.asarray(c, dtype=float) for c in cols.values()]))
-
-
 class Samples:
     """Preallocated sample arrays of one rollout of one actuator (an
     :class:`~mjeap.simulation.part.ActuatorPart`). A sample copies MuJoCo's raw world positions
@@ -93,7 +53,7 @@ class Samples:
         self._bodies = np.r_[part.clamp_id, part.link_ids].astype(np.intp)
         self._raw = np.empty((ns, N + 2 + (part.payload_id >= 0), 3))
         self._xmat = np.empty((ns, 9))
-        self._moving = part._fixed_rotation is None
+        self._moving = part.clamp_moves
         self._clamp_xmat = np.empty((ns, 9)) if self._moving else None
         self.t, self.v = np.empty(ns), np.empty(ns)
         self.sig: Dict[str, np.ndarray] = {}
@@ -101,6 +61,17 @@ class Samples:
         #: called with this store after every sample; may raise a decision to stop the run
         #: (:class:`mjeap.simulation.periodic.PeriodicStop`)
         self.stop = None
+
+    def planned_arrays(self) -> dict:
+        """What a run fills, by name: (array, the shape planned for it): times, voltages,
+        raw positions (clamp, links, tip[, payload]), tip orientations and, where the clamp
+        moves, the clamp's."""
+        points = self._bodies.size + 1 + (self.part.payload_id >= 0)       # clamp, links, tip[, payload]
+        out = {"times": (self.t, (self.ns,)), "voltages": (self.v, (self.ns,)),
+               "positions": (self._raw, (self.ns, points, 3)), "orientations": (self._xmat, (self.ns, 9))}
+        if self._clamp_xmat is not None:
+            out["clamp orientations"] = (self._clamp_xmat, (self.ns, 9))
+        return out
 
     def _put(self, key, i, value):
         if key not in self.sig:

@@ -161,14 +161,14 @@ def run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, prog
             samples.take(step * dt, state["hold"] if controller is not None else v_steps[max(step - 1, 0)],
                          drv.signals(), controller)
         except Decided as stop:         # the run ends here (Samples.stop): the scene is in its state
-            stop.step = scene._step_count = step
+            stop.step = scene.step_count = step
             raise
 
     window = [window_state(scene), 0]        # the last state checked: a divergence replays from it
 
     def check(done, k):
         try:
-            scene._step_count = done
+            scene.step_count = done
             scene.check_finite()
         except DivergenceError:
             who = f" Controller: {ctrl_name} (check its gains)." if controller is not None else ""

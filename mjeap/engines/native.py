@@ -9,6 +9,7 @@ import mujoco
 import numpy as np
 
 from ..drives.base import NativeForm
+from ..model.mjcf import HINGE_TENDON
 from .base import CONTROLLER_REASON, Engine
 from .frame import Decided
 from .threaded import LOADS, NATIVE_CONTROL, STATE, ahead_of_stop, raise_bad, roll, spare_datas
@@ -18,8 +19,9 @@ def why_not(scene, drive, controller=None) -> Optional[str]:
     """None where the native engine applies to this run of ``scene``; else why not."""
     if controller is not None:
         return CONTROLLER_REASON
-    if scene.builder.native_reason is not None:
-        return scene.builder.native_reason
+    lack = scene.builder.lacks(HINGE_TENDON)
+    if lack is not None:
+        return f"the native drives' moment is a fixed tendon over one bending joint per hinge: {lack}"
     reason = drive.native_reason()
     if reason is not None:
         return f"the {drive.name} drive has no native form: {reason}"
@@ -113,6 +115,6 @@ def run_native(scene, native, drives: Sequence, v_steps: Sequence[np.ndarray], i
     mujoco.mj_setState(m, d, final[-1], STATE)
     mujoco.mj_kinematics(m, d)
     drives[-1].native_leave(n, part, h, before=before[-1])
-    scene._step_count = n
+    scene.step_count = n
     if decided is not None:
         raise decided

@@ -19,6 +19,7 @@ which replays the drive's own step), so they are the lockstep loop's read-outs e
 """
 from __future__ import annotations
 
+import weakref
 from concurrent.futures import Future, ThreadPoolExecutor
 from contextlib import nullcontext
 from functools import partial
@@ -29,6 +30,7 @@ import numpy as np
 from mujoco import rollout as mj_rollout
 
 from ..errors import DivergenceError
+from ..model.mjcf import FIXED_BENDING_FORCES
 from .base import CONTROLLER_REASON, Engine
 from .frame import Decided
 
@@ -54,8 +56,9 @@ def why_not(scene, drive, controller=None) -> Optional[str]:
     """None where the threaded engine applies to this run; else the reason, in words."""
     if controller is not None:
         return CONTROLLER_REASON
-    if scene.builder.threaded_reason is not None:
-        return scene.builder.threaded_reason
+    lack = scene.builder.lacks(FIXED_BENDING_FORCES)
+    if lack is not None:
+        return f"mujoco.rollout takes the drive's moments as fixed generalised forces (qfrc_applied controls): {lack}"
     reason = drive.closed_loop_reason()
     if reason is not None:
         return f"the {drive.name} drive is not open-loop: {reason}"
@@ -109,13 +112,17 @@ def roll(model, state0: np.ndarray, controls, ncontrol: int, control_spec, n: in
             spares.extend(datas)
 
 
+#: owner (a scene or native model) -> (its model, its spare MjData), dropped with the owner
+_SPARES: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
+
+
 def spare_datas(owner, model) -> list:
-    """The list of spare MjData of ``model`` kept on ``owner`` (the scene or native model
+    """The list of spare MjData of ``model`` kept for ``owner`` (the scene or native model
     that holds the model, so they live and die together): :func:`roll` borrows from it and
     gives back (a new MjData of the native seed 000 model costs ~0.35 ms, a reset 3 us)."""
-    held = owner.__dict__.get("_spare_datas")
+    held = _SPARES.get(owner)
     if held is None or held[0] is not model:        # a recompiled model: a fresh list
-        held = owner.__dict__["_spare_datas"] = (model, [])
+        held = _SPARES[owner] = (model, [])
     return held[1]
 
 
@@ -231,7 +238,7 @@ def run(scene, drives: Sequence, v_steps: Sequence[np.ndarray], initial_curvatur
     # leave the scene and the (last) drive as the lockstep loop does: final state, the
     # moments of the last step still applied (seek replays that step)
     replay(drives[-1], n, final[-1], before[-1])
-    scene._step_count = n
+    scene.step_count = n
     scene.update_kinematics()
     if decided is not None:
         raise decided
@@ -249,7 +256,7 @@ def raise_bad(scene, put, drives, v_steps, bad) -> None:
     has put the scene in it."""
     b, step, state = bad
     B = len(drives)
-    scene._step_count = step
+    scene.step_count = step
     if state is None:
         raise _error(scene, drives[b], v_steps[b][-1], b, B, "MuJoCo warned of a bad acceleration on the last step; ")
     put(state)

@@ -135,7 +135,7 @@ class CurvatureTrackingTask:
         kappa0 = self.episode["initial_curvature_per_m"]
         if kappa0:
             sc.set_hinge_angles(np.full(sc.layout.segments, kappa0 * sc.layout.ds))
-        sc._step_count = 0
+        sc.step_count = 0
         physics.drive.reset(kappa0)
         physics.voltage = physics.drive.rest_voltage()
         self.limiter.reset()

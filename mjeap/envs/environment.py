@@ -92,7 +92,7 @@ def run_episode(env: dm_env.Environment, policy: Callable, rrd=None):
     Ctrl-C or SIGTERM; a second writer of it is refused, :func:`mjeap.io.outputs.guarded`)."""
     from ..model.analytical import arc_curvature
     from ..io.recording import write_recording
-    from ..engines.frame import RolloutResult
+    from ..engines.result import RolloutResult
     from ..io.outputs import write_outputs
 
     physics, task = env.physics, env.task

@@ -154,7 +154,7 @@ class CurvatureTrackingEnv(gymnasium.Env):
         warned = [w.name for w in BAD_STATE_WARNINGS if d.warning[w].number > 0]
         if not warned and not diverged(d):
             return ""
-        why = str(divergence_error(self.scene, self.drive, self.voltage, self.scene._step_count,
+        why = str(divergence_error(self.scene, self.drive, self.voltage, self.scene.step_count,
                                    window=(self._window, self._n_sub)))
         return why + (f" MuJoCo warned: {', '.join(warned)}." if warned else "")
 

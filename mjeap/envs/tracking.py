@@ -134,7 +134,7 @@ def step_lockstep(scene, drive, voltage: float, nstep: int) -> None:
     once per step (the environments' engine, :func:`mjeap.engines.stepper`). No divergence check and no kinematics
     update: the caller does both."""
     stepper().advance(scene, drive, voltage, nstep)
-    scene._step_count += nstep
+    scene.step_count += nstep
 
 
 def observe(scene, drive, reference: Callable[[float], float], signal_names: List[str]):

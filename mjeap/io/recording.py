@@ -410,7 +410,7 @@ def _write_system_recording(path, result, system, extra, views, actuator_views=T
             if not n:
                 continue
             # the centreline back in the world: clamp position + clamp rotation x clamp-frame points
-            R = p.rotation if p._fixed_rotation is not None else None
+            R = None if p.clamp_moves else p.rotation
             clamp = result.body_position[idx, p.clamp_id]
             pts = r.centreline[idx]
             if R is not None:

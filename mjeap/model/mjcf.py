@@ -21,7 +21,9 @@ internal units of a :class:`~mjeap.units.UnitSystem`.
 A builder owns everything that differs between representations, so that the rest of mjeap
 asks it and a new beam type is one module: what it builds, which integrators it runs under
 and whether they integrate its stiffness implicitly, how it is damped and linearised, which
-engines and features apply to it (each refusal with its reason), and, through its
+what its model is in model terms (:attr:`BeamBuilder.capabilities`: a fixed tendon can sum its
+bending, its moments are fixed generalised forces, ...; each engine or feature above words
+its own refusal from them), and, through its
 :class:`~mjeap.model.views.BeamView`, how its bending is read, set and driven in a compiled
 model.
 """
@@ -38,6 +40,20 @@ from ..errors import ParameterError, UnknownNameError, check_registration
 from ..units import UnitSystem
 
 GRAVITY = 9.80665  # m/s^2
+
+# What a beam's model is, in model terms (BeamBuilder.capabilities); the layers above read
+# them and word their own refusals (a new engine names what it needs, not a new attribute here)
+#: one scalar joint per hinge carries its bending, so a fixed tendon sums the hinges (the
+#: compiled drive moments of mjeap.drives.native)
+HINGE_TENDON = "one tendon per hinge"
+#: a hinge moment is a constant generalised force on its dof (qfrc_applied), whatever the
+#: configuration
+FIXED_BENDING_FORCES = "fixed generalised bending forces"
+#: its discretisation error follows the hinge chain's (order 2 in segments; the accuracy model)
+HINGE_CHAIN_ERROR = "the hinge chain's discretisation error"
+#: MjSpec.attach of its clamp body carries the whole beam into a host
+ATTACHED_WHOLE = "attached whole with its clamp body"
+CAPABILITIES = (HINGE_TENDON, FIXED_BENDING_FORCES, HINGE_CHAIN_ERROR, ATTACHED_WHOLE)
 BEAM_RGBA = [0.2, 0.45, 0.8, 1.0]
 
 
@@ -76,12 +92,23 @@ class BeamBuilder:
     check_bent_stability: bool = False
     #: per-hinge stiffness and damping can be set (mjeap.analysis.identify)
     per_hinge_parameters: bool = False
-    #: why a native drive (mjeap.drives.native), the threaded engine, a run at an accuracy target,
-    #: attaching to a host (mjeap.simulation.system) do not apply (None: they do)
-    native_reason: Optional[str] = None
-    threaded_reason: Optional[str] = None
-    accuracy_reason: Optional[str] = None
-    attach_reason: Optional[str] = None
+    #: what the model is, in model terms (HINGE_TENDON, FIXED_BENDING_FORCES, ...): the hinge
+    #: chain is all of them
+    capabilities: frozenset = frozenset(CAPABILITIES)
+    #: for a capability it lacks, what the model is instead (model terms)
+    instead: Dict[str, str] = {}
+
+    def has(self, capability: str) -> bool:
+        """Whether the model is ``capability`` (one of :data:`CAPABILITIES`, or a name a
+        layer above asks about: absent unless the builder states it)."""
+        return capability in self.capabilities
+
+    def lacks(self, capability: str) -> Optional[str]:
+        """None where the model has ``capability``; else what it is instead, in words."""
+        if self.has(capability):
+            return None
+        return self.instead.get(capability, f"the {self.representation} representation does not state "
+                                            f"'{capability}'")
 
     def unavailable_reason(self) -> Optional[str]:
         """Why this MuJoCo cannot run the representation (None: it can)."""
@@ -219,10 +246,11 @@ class CableBuilder(BeamBuilder):
     prefix = "cable"
     stores_dof_damping = True
     check_bent_stability = True
-    native_reason = ("the cable representation's ball joints cannot be summed by a fixed tendon "
-                     "(the native drives act on the hinge chain)")
-    accuracy_reason = ("no target on a 'cable' scene (give segments and timestep): the accuracy model is the "
-                       "hinge chain's (order 2 in segments)")
+    capabilities = frozenset({FIXED_BENDING_FORCES, ATTACHED_WHOLE})
+    instead = {HINGE_TENDON: "the cable representation's hinges are ball joints (three dofs each), which a fixed "
+                             "tendon cannot sum",
+               HINGE_CHAIN_ERROR: "the cable's discretisation error is not measured (the plugin's stiffness per "
+                                  "segment is not the hinge chain's)"}
 
     def unavailable_reason(self):
         from ..versions import MUJOCO_VERSION, cable_available

@@ -98,7 +98,8 @@ import numpy as np
 from ..errors import ParameterError
 from ..units import UnitSystem
 from .discretize import BeamLayout
-from .mjcf import BEAM_RGBA, BeamBuilder, BeamHandles, _finder, _set_inertial, register
+from .mjcf import (ATTACHED_WHOLE, BEAM_RGBA, FIXED_BENDING_FORCES, HINGE_CHAIN_ERROR, HINGE_TENDON, BeamBuilder,
+                   BeamHandles, _finder, _set_inertial, register)
 from .views import BeamView, into
 
 #: impedance of the rod's edge constraints: 1 - d = 1e-4 of the violation's restoring
@@ -125,15 +126,15 @@ class RodBuilder(BeamBuilder):
     integrators = ("discrete",)
     default_integrator = "discrete"
     name = "rod"
-    native_reason = ("the rod has no bending joints for a native drive's fixed tendon to sum (its turning angles are "
-                     "functions of the flex vertices; see mjeap.rod for what a native form would need)")
-    threaded_reason = ("the rod's moments act as forces along its present edge normals, not as fixed generalised "
-                       "forces that mujoco.rollout could take as qfrc_applied controls")
-    accuracy_reason = ("no target on a 'rod' scene (give segments and timestep): the accuracy model is the hinge "
-                       "chain's")
-    attach_reason = ("MjSpec.attach of the clamp body carries the rod's flex but not its per-edge twist bodies, which "
-                     "the flexcomp puts under the world body, and MuJoCo refuses a box-section rod without them "
-                     "('requires per-edge twist joints')")
+    capabilities = frozenset()
+    instead = {HINGE_TENDON: "the rod has no bending joints: its turning angles are functions of the flex vertices "
+                             "(see mjeap.model.rod for what a native form would need)",
+               FIXED_BENDING_FORCES: "the rod's moments act as forces along its present edge normals, which turn "
+                                     "with its configuration",
+               HINGE_CHAIN_ERROR: "the rod's discretisation error is its flex's, not the hinge chain's",
+               ATTACHED_WHOLE: "MjSpec.attach of the clamp body carries the rod's flex but not its per-edge twist "
+                               "bodies, which the flexcomp puts under the world body, and MuJoCo refuses a "
+                               "box-section rod without them ('requires per-edge twist joints')"}
 
     def unavailable_reason(self):
         from ..versions import MUJOCO_VERSION, mujoco_major

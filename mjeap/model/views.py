@@ -58,6 +58,12 @@ class BeamView:
         """Views of ``data`` for the per-step paths (made once per MjData)."""
         self.data = data
 
+    def direct_arrays(self) -> tuple:
+        """(angles, moments): views (no copies) of the hinges' angles in ``qpos`` and their
+        bending forces in ``qfrc_applied`` of the bound data, each None where the hinges are
+        not evenly spaced joints (:meth:`bind`)."""
+        return getattr(self, "_qpos_bend", None), getattr(self, "_qfrc_bend", None)
+
     def angles(self, out: Optional[np.ndarray] = None) -> np.ndarray:
         """Bending angle (rad) of every hinge about the hinge axis."""
         raise NotImplementedError

@@ -74,9 +74,10 @@ from typing import List, Optional
 import numpy as np
 
 from ..errors import ParameterError
+from ..model.mjcf import HINGE_CHAIN_ERROR
 
 __all__ = ["QUANTITY", "ACCURACY_RANGE", "Model", "ErrorModel", "check_accuracy", "target_for", "relative_difference",
-           "calibrate", "choose_model", "run_at_accuracy", "estimate_error", "as_error_model", "fewer_segments",
+           "calibrate", "choose_model", "check_targetable", "run_at_accuracy", "estimate_error", "as_error_model", "fewer_segments",
            "spatial_error", "half_step_error", "estimate_system_error"]
 
 QUANTITY = ("tip curvature: max over the samples of |kappa - kappa_converged| / swing, the swing being the "
@@ -354,6 +355,15 @@ def as_error_model(value) -> ErrorModel:
     return ErrorModel(a, b)
 
 
+def check_targetable(scene, accuracy) -> None:
+    """Refuse an accuracy target on a scene whose model the error model does not describe
+    (the hinge chain's, order 2 in segments), naming what the model is instead."""
+    lack = scene.builder.lacks(HINGE_CHAIN_ERROR)
+    if lack is not None:
+        raise ParameterError("accuracy", accuracy, f"no target on a '{scene.representation}' scene (give segments "
+                             "and timestep): the accuracy model is the hinge chain's (order 2 in segments)", lack)
+
+
 def run_at_accuracy(scene, run, *, accuracy: float, duration: float, wave=None,
                     sample_interval: Optional[float] = None, error_model=None, pilot_run=None):
     """Choose, run and check a model of ``scene`` for ``accuracy``. ``run(scene, interval)``
@@ -367,8 +377,7 @@ def run_at_accuracy(scene, run, *, accuracy: float, duration: float, wave=None,
     model, report dict), the report also put in each result's ``meta['accuracy']``."""
     target = check_accuracy(accuracy)
     given = None if error_model is None else as_error_model(error_model)
-    if scene.builder.accuracy_reason is not None:
-        raise ParameterError("accuracy", accuracy, scene.builder.accuracy_reason)
+    check_targetable(scene, accuracy)
     t0 = _time.perf_counter()
     grid = _grid(duration, sample_interval)
     h_cap = _step_cap(scene, wave, grid)

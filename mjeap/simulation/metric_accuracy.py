@@ -57,7 +57,8 @@ import numpy as np
 from mujoco import rollout as mj_rollout
 
 from ..errors import ParameterError
-from .accuracy import SAFETY, ErrorModel, Model, as_error_model, check_accuracy, choose_model, fewer_segments
+from .accuracy import (SAFETY, ErrorModel, Model, as_error_model, check_accuracy, check_targetable, choose_model,
+                       fewer_segments)
 
 __all__ = ["METRIC_SCALES", "check_metrics", "answerable", "relaxed_step_cap", "last_period",
            "peak_to_peak", "returns_margin", "metric_quantity", "metric_scale", "run_metrics_at_accuracy",
@@ -412,8 +413,7 @@ def run_metrics_at_accuracy(scene, run, *, metrics: Sequence[str], accuracy: flo
     target = check_accuracy(accuracy)
     names = check_metrics(metrics)
     given = None if error_model is None else as_error_model(error_model)
-    if scene.builder.accuracy_reason is not None:
-        raise ParameterError("accuracy", accuracy, scene.builder.accuracy_reason)
+    check_targetable(scene, accuracy)
     t0 = _time.perf_counter()
     period = 1.0 / wave.frequency if wave is not None and getattr(wave, "frequency", 0) else None
     relaxed, why = relaxed_step_cap(scene, drive, wave, names)

@@ -12,6 +12,7 @@ import mujoco
 from ..drives import make_drive
 from ..engines.native import why_not
 from ..model.fields import add_units
+from ..model.mjcf import FIXED_BENDING_FORCES
 
 __all__ = ["ModelFile", "model_file", "add_viewing", "DRIVE_ACTUATOR"]
 
@@ -50,7 +51,7 @@ def model_file(scene, drive=None, drive_params: Optional[dict] = None, how_to_vi
     else:
         spec = scene.spec.copy()
         add_units(spec, scene.units)
-        engines = "loop engine" if scene.builder.threaded_reason else "loop or threaded engine"
+        engines = "loop or threaded engine" if scene.builder.has(FIXED_BENDING_FORCES) else "loop engine"
         out = ModelFile(spec, f"Passive beam: {why}. Drive it with mjeap ({engines}).", None, why=why)
     add_viewing(out.spec, scene)
     return out

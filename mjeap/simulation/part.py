@@ -158,7 +158,7 @@ class ActuatorPart:
         hinges are evenly spaced joints whose moments do not follow the geometry and whose
         stiffness is the model's own; the views are valid until the part is bound again."""
         v = self.view
-        angles, moments = getattr(v, "_qpos_bend", None), getattr(v, "_qfrc_bend", None)
+        angles, moments = v.direct_arrays()
         if angles is None or moments is None or v.moments_follow_geometry or \
                 (self._stiffness_scale != 1.0 and not self._stiffness_in_model):
             return None
@@ -180,6 +180,18 @@ class ActuatorPart:
         moments follow its geometry, before each step; the drives set them every step)."""
         if self._moments is not None:
             self.set_internal_moments(self._moments)
+
+    @property
+    def stiffness_scale(self) -> float:
+        """The factor a drive set on every hinge's bending stiffness
+        (:meth:`set_bending_stiffness_scale`; 1: the catalog beam's)."""
+        return self._stiffness_scale
+
+    @property
+    def holds_moments(self) -> bool:
+        """Whether internal moments are held to be applied again at each step's configuration
+        (a beam whose moments follow its geometry: the rod; :meth:`reapply_moments`)."""
+        return self._moments is not None
 
     #: whether the model's own stiffness follows set_bending_stiffness_scale (else the
     #: change is applied as a moment with the drives' moments)
@@ -282,6 +294,17 @@ class ActuatorPart:
         d.xfrc_applied[b, 3:] = self.rotation[:, 2] * self._tip_moment
 
     # ------------------------------------------------------------------ read-outs (SI)
+    @property
+    def clamp_moves(self) -> bool:
+        """Whether the clamp frame can move (a mount on a free or jointed body); else its
+        rotation is fixed (:meth:`fix_rotation`)."""
+        return self._fixed_rotation is None
+
+    def fix_rotation(self, rotation) -> None:
+        """Declare the clamp frame fixed at the world ``rotation`` (3 x 3; a clamp welded to
+        the world)."""
+        self._fixed_rotation = np.array(rotation, dtype=float).reshape(3, 3)
+
     @property
     def rotation(self) -> np.ndarray:
         """World rotation of the clamp frame (columns: beam axis, deflection, hinge axis)."""

@@ -1,12 +1,13 @@
 """Headless rollouts: a scene, a drive and a voltage waveform, on one of the engines of
 :mod:`mjeap.engines` (``auto``: native where the drive has a native form, else threaded
 where it is open-loop, else the Python loop; all give the same trajectory, tested to
-round-off). The waveform is evaluated for all steps up front (vectorised).
+round-off). The waveform is evaluated for all steps up front (vectorised). :func:`rollout`
+and :func:`rollout_batch` are front ends of the one run pipeline,
+:mod:`mjeap.simulation.pipeline` (as is :meth:`mjeap.System.rollout`).
 """
 from __future__ import annotations
 
 import os
-import time as _time
 from pathlib import Path
 from typing import List, Optional, Sequence, Union
 
@@ -15,9 +16,12 @@ import numpy as np
 from .accuracy import GRID_SAMPLES, target_for
 from ..engines import ENGINES, choose, run_checked
 from .periodic import MIN_SAMPLES_PER_PERIOD, PeriodicStop, check_periodic_stop
-from ..engines.frame import (Decided, DEFAULT_SAMPLES, MAX_INITIAL_BEND, MAX_STEPS, RolloutResult, Samples, check_controller, check_initial_curvature, check_sampling, check_work, one_voltage, sample_steps, to_waveform, voltage_steps)
+from ..engines.frame import (DEFAULT_SAMPLES, MAX_INITIAL_BEND, MAX_STEPS, check_controller, check_initial_curvature,
+                             check_sampling, check_work, one_voltage, to_waveform)
+from ..engines.result import RolloutResult
 from ..errors import ParameterError, check_integer, check_positive
 from ..io.outputs import check_outputs, guarded, write_outputs
+from .pipeline import execute, plan, write_run
 from .scene import Scene
 from ..drives.waveforms import Waveform
 
@@ -35,12 +39,12 @@ def check_stop(stop_when_periodic, wave, duration: float, sample_interval: Optio
                                duration / (GRID_SAMPLES if at_accuracy else DEFAULT_SAMPLES))
 
 
-def _meta(scene, drv, wave, duration, initial_curvature, n_steps, engine) -> dict:
-    from ..io.outputs import provenance
-    return {**provenance(), "actuator": scene.actuator.id, "drive": drv.describe(),
+def _meta(scene, drv, wave, duration, initial_curvature) -> dict:
+    """What a scene's run describes in its meta (:func:`mjeap.simulation.pipeline.plan` adds
+    the provenance, steps and engine)."""
+    return {"actuator": scene.actuator.id, "drive": drv.describe(),
             "voltage": "closed loop" if wave is None else getattr(wave, "text", str(wave)),
-            "duration_s": duration, "initial_curvature_per_m": initial_curvature, "steps": n_steps,
-            "engine": engine, "scene": scene.summary(),
+            "duration_s": duration, "initial_curvature_per_m": initial_curvature, "scene": scene.summary(),
             "drive_parameters": {k: [v, drv.sources.get(k, "")] for k, v in drv.params.items()}}
 
 
@@ -90,7 +94,6 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     the result ends there (at an accuracy target every run of the choice stops on its own).
     """
     from ..drives import make_drive
-    from ..io import recording
 
     duration = check_positive("duration", duration, "s")
     ctrl_name = None if controller is None else check_controller(controller, voltage)
@@ -115,41 +118,20 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
                                     check_every, controller, engine, max_steps, target, wave, error_model,
                                     stop_when_periodic, metrics)
     eng, engine_reason = choose(engine, scene, drv, controller)
-    dt = scene.timestep
-    v_steps = voltage_steps(wave, duration, dt, drv, max_steps)
-    n_steps = len(v_steps)
-    steps = sample_steps(n_steps, dt, sample_interval)
-    samples = Samples(eng.part(scene, drv), len(steps))
+    p = plan(eng, engine_reason, [wave], [drv], lambda: [eng.part(scene, drv)], duration, scene.timestep,
+             sample_interval, _meta(scene, drv, wave, duration, initial_curvature), max_steps=max_steps)
+    (samples,) = p.samples
     if stop_when_periodic is not None:
         samples.stop = PeriodicStop(period, stop_tol, scene.layout.length)
-    meta = _meta(scene, drv, wave, duration, initial_curvature, n_steps, eng.name)
-    meta["engine_reason"] = engine_reason
     if scene.choice.buckled:
-        meta.setdefault("warnings", []).append(scene.buckled_warning())
+        p.meta.setdefault("warnings", []).append(scene.buckled_warning())
     if controller is not None:
-        meta["controller"] = ctrl_name
-    error = None
-    wall0 = _time.perf_counter()
-    try:
-        run_checked(eng, scene, [drv], [v_steps], [initial_curvature], steps, [samples], progress=progress,
-                    check_every=check_every, controller=controller, meta=meta)
-    except Decided as stop:     # a finished run that ends early: its result, not an error
-        meta["stopped_early"], meta["steps_run"] = stop.reason, stop.step
-    except BaseException as e:  # record what was simulated, then re-raise
-        error = e
-        raise
-    finally:
-        meta["wall_time_s"] = _time.perf_counter() - wall0
-        result = samples.result(drv, initial_curvature, meta)
-        if error is not None:
-            meta["error"] = f"{type(error).__name__}: {error}"
-        writers = []
-        if rrd is not None:
-            writers.append((rrd, lambda: recording.write_recording(rrd, result, scene)))
-        if csv_path is not None and samples.n > 0:
-            writers.append((csv_path, lambda: result.to_csv(csv_path)))
-        write_outputs(writers, error, result)
-    return result
+        p.meta["controller"] = ctrl_name
+    return execute(p.meta, lambda: run_checked(eng, scene, [drv], p.v_steps, [initial_curvature], p.sample_steps,
+                                               p.samples, progress=progress, check_every=check_every,
+                                               controller=controller, meta=p.meta),
+                   lambda error: samples.result(drv, initial_curvature, p.meta),
+                   lambda result, error: write_run(result, scene, rrd, csv_path, error))
 
 
 def _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, csv_path, sample_interval,
@@ -159,8 +141,6 @@ def _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, 
     runs of :mod:`mjeap.simulation.accuracy`, each with the drive ``drv`` names and its parameters;
     the outputs hold the chosen run, whose meta says how it was chosen."""
     from . import accuracy as acc
-    from ..io import recording
-    from ..drives import make_drive
     params = dict(drv.params)
 
     def run(s, interval):
@@ -189,12 +169,7 @@ def _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, 
     else:
         result, chosen, _ = acc.run_at_accuracy(scene, run, accuracy=target, duration=duration, wave=wave,
                                                 sample_interval=sample_interval, error_model=error_model)
-    writers = []
-    if rrd is not None:
-        writers.append((rrd, lambda: recording.write_recording(rrd, result, chosen)))
-    if csv_path is not None:
-        writers.append((csv_path, lambda: result.to_csv(csv_path)))
-    write_outputs(writers, None, result)
+    write_run(result, chosen, rrd, csv_path)
     return result
 
 
@@ -267,20 +242,13 @@ def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable
                                sample_interval=sample_interval,
                                pilot_run=(lambda s, i: run(s, i, slice(1))) if len(voltages) > 1 else None)[0]
     drives = [make_drive(drive, scene, **(drive_params or {})) for _ in voltages]
-    eng, _ = choose(engine, scene, drives[0], None, batched=True)
-    dt = scene.timestep
+    eng, engine_reason = choose(engine, scene, drives[0], None, batched=True)
     waves = [to_waveform(v, duration) for v in voltages]
-    v_steps = [voltage_steps(w, duration, dt, d) for w, d in zip(waves, drives)]
-    steps = sample_steps(len(v_steps[0]), dt, sample_interval)
-    part = eng.part(scene, drives[0])
-    samples = [Samples(part, len(steps)) for _ in voltages]
-    wall0 = _time.perf_counter()
     engine_meta: dict = {}              # what the engine says of its run (the warp engine's settings)
-    run_checked(eng, scene, drives, v_steps, list(kappa0), steps, samples, nthread=nthread, meta=engine_meta)
-    wall = _time.perf_counter() - wall0
-    out = []
-    for w, d, k0, smp in zip(waves, drives, kappa0, samples):
-        meta = _meta(scene, d, w, duration, float(k0), len(v_steps[0]), eng.name)
-        meta.update(engine_meta, wall_time_s=wall, batch=len(voltages), nthread=nthread)
-        out.append(smp.result(d, float(k0), meta))
-    return out
+    p = plan(eng, engine_reason, waves, drives, lambda: [eng.part(scene, drives[0])] * len(voltages), duration,
+             scene.timestep, sample_interval, {"batch": len(voltages), "nthread": nthread})
+    return execute(p.meta, lambda: run_checked(eng, scene, drives, p.v_steps, list(kappa0), p.sample_steps,
+                                               p.samples, nthread=nthread, meta=engine_meta),
+                   lambda error: None if error is not None else
+                   [smp.result(d, float(k0), {**p.meta, **_meta(scene, d, w, duration, float(k0)), **engine_meta})
+                    for w, d, k0, smp in zip(waves, drives, kappa0, p.samples)])

@@ -323,6 +323,12 @@ class Scene:
         beta = c.rayleigh_beta - (timestep if numerical else 0.0)
         return max(beta, 0.0) / u.time
 
+    @property
+    def arguments(self) -> dict:
+        """The arguments this scene was built with (actuator, representation, orientation,
+        payload, units, damping_ratio, gravity, max_bend, accuracy): a copy."""
+        return dict(self._arguments)
+
     def variant(self, segments: int, timestep: float, integrator: str) -> "Scene":
         """This scene (actuator, orientation, payload, units, damping, gravity) as a model
         of ``segments`` hinges stepped at ``timestep`` (s) under ``integrator``, as chosen for
@@ -384,20 +390,21 @@ class Scene:
         if curvature:
             self.part.set_hinge_angles(np.full(self.layout.segments, curvature * self.layout.ds), forward=False)
         mujoco.mj_forward(self.model, self.data)
-        self._step_count = 0
+        #: steps since the last reset (the engines and environments that step it advance it)
+        self.step_count = 0
 
     # ------------------------------------------------------------------ stepping
     def step(self, n: int = 1) -> None:
         """Advance ``n`` steps; raises :class:`DivergenceError` if the state blows up. Internal
         moments set on a beam whose moments follow its geometry (the rod) are applied again
         at each step's configuration."""
-        if self.part._moments is not None:
+        if self.part.holds_moments:
             for _ in range(n):
                 self.part.reapply_moments()
                 mujoco.mj_step(self.model, self.data)
         else:
             mujoco.mj_step(self.model, self.data, nstep=n)
-        self._step_count += n
+        self.step_count += n
         self.check_finite()
         self.update_kinematics()
 
@@ -424,7 +431,7 @@ class Scene:
         beam_mass = float(self.layout.link_mass.sum())
         heavy = self.payload is not None and self.payload.mass > HEAVY_PAYLOAD * beam_mass
         return DivergenceError(
-            f"{self.actuator.id} ({self.representation}) diverged by step {self._step_count} "
+            f"{self.actuator.id} ({self.representation}) diverged by step {self.step_count} "
             f"(t = {self.time:.6g} s): timestep {c.timestep:.4g} s, stability limit "
             f"{c.stability_limit:.4g} s set by the highest bending mode ({c.highest_frequency:.4g} Hz) "
             f"under {c.integrator}" + ("; the reference configuration is buckled under gravity"

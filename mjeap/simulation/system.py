@@ -20,7 +20,6 @@ MuJoCo's 1e-15 floors, with the part named and a unit system that works.
 from __future__ import annotations
 
 import re
-import time as _time
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Dict, List, Optional, Sequence, Union
@@ -31,9 +30,9 @@ import numpy as np
 from ..drives.native import NativeHandles
 from .part import ActuatorPart
 from ..errors import DivergenceError, ParameterError, UnknownNameError, check_positive
-from ..io.outputs import guarded, provenance
+from ..io.outputs import guarded
 from ..versions import newton_sparse_broken
-from ..engines.frame import one_voltage
+from ..engines.frame import check_work, one_voltage
 from ..engines.native import why_not as native_why_not
 from ..model.fields import UNITS_FIELD, add_units, apply_dof_damping
 from .scene import DEFAULT_SEGMENTS, INTEGRATORS, Scene, diverged
@@ -278,9 +277,11 @@ def attach(spec: mujoco.MjSpec, actuator, *, prefix: str, site: Optional[str] = 
     check_spec(spec)
     units = units or DEFAULT_UNITS
     from ..model.mjcf import get_builder
-    why = get_builder(representation).attach_reason
+    from ..model.mjcf import ATTACHED_WHOLE
+    why = get_builder(representation).lacks(ATTACHED_WHOLE)
     if why is not None:
-        raise ParameterError("representation", representation, "'hinge' (or 'cable' on MuJoCo 3.x) for attach", why)
+        raise ParameterError("representation", representation, "'hinge' (or 'cable' on MuJoCo 3.x) for attach: a "
+                             "beam that MjSpec.attach carries whole with its clamp body", why)
     integrator = integrator or ("discrete" if contact else "implicitfast")
     if not isinstance(prefix, str) or not _PREFIX.match(prefix):
         raise ParameterError("prefix", prefix, "a name of letters, digits, '_' or '-', starting with a letter")
@@ -473,11 +474,12 @@ class System:
             part.bind(self.data)
             if fixed:
                 mujoco.mj_kinematics(m, self.data)
-                part._fixed_rotation = self.data.xmat[clamp].reshape(3, 3).copy()
+                part.fix_rotation(self.data.xmat[clamp].reshape(3, 3))
             self.parts.append(part)
             self.actuator_ids.append(-1 if a.actuator_name is None else
                                      mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_ACTUATOR, a.actuator_name))
-        self._step_count = 0
+        #: steps since the last reset (the engines that step the system advance it)
+        self.step_count = 0
         self.reset()
 
     # ------------------------------------------------------------------ access
@@ -541,7 +543,7 @@ class System:
         for a, i in zip(self.actuators, self.actuator_ids):
             if i >= 0:
                 d.ctrl[i] = a.drive.rest_voltage()
-        self._step_count = 0
+        self.step_count = 0
 
     def _per_actuator(self, name: str, values) -> list:
         """One value per actuator from a list, a dict by prefix or one value for all; a bare
@@ -577,14 +579,14 @@ class System:
     def step(self, n: int = 1) -> None:
         """Advance ``n`` steps; raises :class:`DivergenceError` if the state blows up."""
         mujoco.mj_step(self.model, self.data, nstep=n)
-        self._step_count += n
+        self.step_count += n
         self.check_finite()
         mujoco.mj_kinematics(self.model, self.data)
 
     def check_finite(self) -> None:
         if diverged(self.data):
             raise DivergenceError(
-                f"system of {len(self)} actuators diverged by step {self._step_count} (t = {self.time:.6g} s): "
+                f"system of {len(self)} actuators diverged by step {self.step_count} (t = {self.time:.6g} s): "
                 f"timestep {self.timestep:.4g} s ({self.timestep_reason}); check the host's bodies, joints and "
                 "contacts (a stiff or light part may need a smaller timestep)")
 
@@ -659,10 +661,9 @@ class System:
         ``estimate_error``: each actuator's tip-curvature error from the timestep, against the
         system at half the step (:func:`mjeap.simulation.accuracy.estimate_system_error`; 2 x
         the cost; open loop without ``on_sample``), in ``meta['accuracy']``."""
-        from ..engines import choose_system, run_system_checked
-        from ..engines.frame import (Samples, check_controller, check_work, controller_every, reset_controller,
-                                     sample_steps as steps_of, to_waveform, voltage_steps)
-        from ..io.outputs import write_outputs
+        from ..engines import choose_system
+        from ..engines.frame import check_controller, to_waveform
+        from .pipeline import execute, plan, write_run
         duration = check_positive("duration", duration, "s")
         ctrl_name = None if controller is None else check_controller(controller)
         if estimate_error and (controller is not None or on_sample is not None):
@@ -678,21 +679,47 @@ class System:
                 raise ParameterError("voltages", voltages, "None when a controller sets the voltages")
             voltages = None
         waves = [None if w is None else to_waveform(w, duration) for w in self._per_actuator("voltages", voltages)]
-        dt = self.timestep
-        n_steps = check_work(duration, dt)
-        v_steps = []
+        check_work(duration, self.timestep)
         for a, w in zip(self.actuators, waves):
-            if a.drive is None:
-                if w is not None:
-                    raise ParameterError("voltages", getattr(w, "text", w), f"None for the passive actuator '{a.prefix}'")
-                v_steps.append(None)
-                continue
-            # a waveform is checked against the drive's safe range there; the rest voltage is in it
-            v_steps.append(np.full(n_steps, a.drive.rest_voltage()) if w is None else
-                           voltage_steps(w, duration, dt, a.drive, remedy=SYSTEM_TIMESTEP))
-        sample_steps = steps_of(n_steps, dt, sample_interval)
-        ns = len(sample_steps)
-        samples = [Samples(p, ns) for p in self.parts]
+            if a.drive is None and w is not None:
+                raise ParameterError("voltages", getattr(w, "text", w), f"None for the passive actuator '{a.prefix}'")
+        # a waveform is checked against the drive's safe range; the rest voltage (None) is in it
+        p = plan(eng, engine_reason, waves, [a.drive for a in self.actuators], self.parts, duration, self.timestep,
+                 sample_interval, self._describe(waves, controller, ctrl_name, duration), remedy=SYSTEM_TIMESTEP,
+                 rest=True)
+        run, finish = self._stepping(p, initial_curvatures, on_sample, controller, ctrl_name)
+
+        def finish_estimated(error):
+            res = finish()
+            if estimate_error and error is None:
+                from .accuracy import estimate_system_error
+                estimate_system_error(self, res, lambda comp, interval: comp.rollout(
+                    voltages, duration, initial_curvatures, sample_interval=interval, engine=engine))
+            return res
+        return execute(p.meta, run, finish_estimated, lambda res, error: write_run(res, self, rrd, error=error))
+
+    def _describe(self, waves, controller, ctrl_name, duration: float) -> dict:
+        """What a run of this system describes in its meta (:func:`mjeap.simulation.pipeline.plan`
+        adds the provenance, steps and engine)."""
+        return {"actuators": {a.prefix.rstrip("/"): {"actuator": a.twin.actuator.id,
+                                                     "drive": None if a.drive is None else a.drive.describe(),
+                                                     "voltage": (f"controller: {ctrl_name}" if controller is not None
+                                                                 and a.drive is not None else
+                                                                 None if w is None else getattr(w, "text", str(w)))}
+                              for a, w in zip(self.actuators, waves)},
+                "duration_s": duration, "timestep_s": self.timestep, "timestep_reason": self.timestep_reason,
+                "units": self.units.describe()}
+
+    def _stepping(self, plan, initial_curvatures, on_sample, controller, ctrl_name):
+        """The system's side of a planned run (:mod:`mjeap.simulation.pipeline`), from its reset
+        state: (run, finish): ``run()`` steps it on the plan's engine (the ctrl held over each
+        step, a controller's voltages, the samples with the bodies' poses and contact forces);
+        ``finish()`` the :class:`SystemResult` of the samples taken."""
+        from ..engines import run_system_checked
+        from ..engines.frame import controller_every, reset_controller
+        eng, n_steps, sample_steps, v_steps, samples = (plan.engine, plan.n_steps, plan.sample_steps, plan.v_steps,
+                                                        plan.samples)
+        dt, ns = self.timestep, len(sample_steps)
         nb = self.model.nbody
         pos, quat, fc = np.empty((ns, nb, 3)), np.empty((ns, nb, 4)), np.empty((ns, nb, 3))
         m, d = self.model, self.data
@@ -702,15 +729,6 @@ class System:
                 a.drive.native_prepare(v, dt)
                 a.drive.part = p
         active = [(i, v) for i, v in zip(self.actuator_ids, v_steps) if v is not None]
-        meta = {**provenance(), "actuators": {a.prefix.rstrip("/"): {"actuator": a.twin.actuator.id,
-                                                     "drive": None if a.drive is None else a.drive.describe(),
-                                                     "voltage": (f"controller: {ctrl_name}" if controller is not None
-                                                                 and a.drive is not None else
-                                                                 None if w is None else getattr(w, "text", str(w)))}
-                              for a, w in zip(self.actuators, waves)},
-                "duration_s": duration, "steps": n_steps, "timestep_s": dt, "timestep_reason": self.timestep_reason,
-                "engine": eng.name, "engine_reason": engine_reason,
-                "units": self.units.describe()}
         ws = np.empty(m.nv)
         # the state before each sampled step: a drive's signals replay that step from it
         # (the piezo bimorph's motional current is at the held voltage's instant)
@@ -718,6 +736,7 @@ class System:
         pre = np.empty(mujoco.mj_stateSize(m, full))
         sampled = np.zeros(n_steps + 1, dtype=bool)
         sampled[sample_steps] = True
+        ctrl_every = 1
 
         def sample(i, k):
             ws[:] = d.qacc_warmstart
@@ -733,8 +752,6 @@ class System:
             if on_sample is not None:
                 on_sample(self)
 
-        error = None
-        wall0 = _time.perf_counter()
         def before(k):
             if controller is not None and k:
                 if k % ctrl_every == 0:
@@ -749,40 +766,29 @@ class System:
                 mujoco.mj_getState(m, d, pre, full)
 
         def check(done, k):
-            self._step_count = done
+            self.step_count = done
             self.check_finite()
 
-        try:
+        def run():
+            nonlocal ctrl_every
             if controller is not None:          # the voltage over step 0 is the first sample's
                 reset_controller(controller, self, None)
                 ctrl_every = controller_every(controller, dt)
                 self._control(controller(0.0, self), v_steps, 0, ctrl_name)
             run_system_checked(eng, self, n_steps, sample_steps, before, sample, check)
-            self._step_count = n_steps
-        except BaseException as e:
-            error = e
-            raise
-        finally:
-            meta["wall_time_s"] = _time.perf_counter() - wall0
-            if error is not None:
-                meta["error"] = f"{type(error).__name__}: {error}"
+            self.step_count = n_steps
+
+        def finish():
             n = samples[0].n if samples else 0
             results = {}
             for a, smp in zip(self.actuators, samples):
-                r = smp.result(a.drive, 0.0, dict(meta))
+                r = smp.result(a.drive, 0.0, dict(plan.meta))
                 r.reference_curvature = None if a.drive is None else r.reference_curvature
                 results[a.prefix.rstrip("/")] = r
             names = [mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b) or f"body{b}" for b in range(nb)]
-            res = SystemResult(samples[0].t[:n] if samples else np.zeros(0), results, names, pos[:n], quat[:n],
-                               fc[:n], meta)
-            if estimate_error and error is None:
-                from .accuracy import estimate_system_error
-                estimate_system_error(self, res, lambda comp, interval: comp.rollout(
-                    voltages, duration, initial_curvatures, sample_interval=interval, engine=engine))
-            if rrd is not None:
-                from ..io.recording import write_system_recording
-                write_outputs([(rrd, lambda: write_system_recording(rrd, res, self))], error, res)
-        return res
+            return SystemResult(samples[0].t[:n] if samples else np.zeros(0), results, names, pos[:n], quat[:n],
+                                fc[:n], plan.meta)
+        return run, finish
 
     def half_step(self) -> "System":
         """This system at half its timestep: a copy of its spec with the same actuators,

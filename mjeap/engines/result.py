@@ -1,0 +1,52 @@
+"""The result of a rollout: one actuator's sampled SI arrays (:class:`RolloutResult`),
+what every engine's samples become (:meth:`mjeap.engines.frame.Samples.result`)."""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Dict, Optional, Union
+
+import numpy as np
+
+from ..io import csvio
+from ..io.outputs import replacing
+
+__all__ = ["RolloutResult"]
+
+
+@dataclass
+class RolloutResult:
+    """Sampled SI arrays of a rollout. Positions are in the clamp frame (x along the
+    undeformed beam, y the deflection, z out of the bending plane). Sample i is the state
+    after step k; its voltage is the one held over that step (zero-order hold), the same
+    instant the drive signals describe."""
+
+    time: np.ndarray                 # (n,) s
+    voltage: np.ndarray              # (n,) V
+    tip_position: np.ndarray         # (n, 3) m
+    tip_angle: np.ndarray            # (n,) rad
+    tip_curvature: np.ndarray        # (n,) 1/m, arc through clamp and tip (seed 000)
+    centreline: np.ndarray           # (n, N + 2, 3) m
+    payload_position: Optional[np.ndarray]
+    signals: Dict[str, np.ndarray]   # drive quantities, 'name (unit)'
+    reference_curvature: Optional[np.ndarray]
+    meta: dict = field(default_factory=dict)
+
+    def peak_to_peak(self, key: str = "tip_curvature", t_from: float = 0.0) -> float:
+        y = getattr(self, key) if hasattr(self, key) else self.signals[key]
+        sel = self.time >= t_from
+        return float(np.max(y[sel]) - np.min(y[sel]))
+
+    def to_csv(self, path: Union[str, Path]) -> None:
+        """Time series (no centreline) as CSV with SI units in the header, written whole
+        (:func:`mjeap.io.outputs.replacing`) and spreadsheet-safe (:class:`mjeap.io.csvio.writer`)."""
+        cols = {"time (s)": self.time, "voltage (V)": self.voltage,
+                "tip_x (m)": self.tip_position[:, 0], "tip_y (m)": self.tip_position[:, 1],
+                "tip_z (m)": self.tip_position[:, 2], "tip_angle (rad)": self.tip_angle,
+                "tip_curvature (1/m)": self.tip_curvature, **self.signals}
+        if self.reference_curvature is not None:
+            cols["reference_curvature (1/m)"] = self.reference_curvature
+        with replacing(path, "csv_path") as tmp, open(tmp, "w", newline="") as fh:
+            w = csvio.writer(fh)
+            w.writerow(cols)
+            w.writerows(np.column_stack([np.asarray(c, dtype=float) for c in cols.values()]))
