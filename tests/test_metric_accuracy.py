@@ -4,12 +4,13 @@ questions, the refusals kept, and the claim against converged goldens
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from mjeap import Scene, rollout
 from mjeap.drives import make_drive
 from mjeap.errors import ParameterError
-from mjeap.simulation.metric_accuracy import check_metrics, relaxed_step_cap
+from mjeap.simulation.metric_accuracy import check_metrics, relaxed_step_cap, run_from_states
 from mjeap.engines.frame import to_waveform
 
 GOLDEN = Path(__file__).parent / "golden" / "metric_accuracy.json"
@@ -94,6 +95,26 @@ def test_claim_on_a_geometry_sweep_of_a_file_actuator():
     s = summarise(rows)
     assert s["below_target"] == 1.0, s
     assert s["estimate_within_3x"] == 1.0, s
+
+
+def test_runs_read_from_their_states_equal_the_native_engines_samples():
+    """A metric target's runs are read from mujoco.rollout's states (chain kinematics for all
+    samples at once, the drive's signal history): the native engine sampled every step gives
+    the same samples (beam points, tip angle and curvature, payload, drive signals) to
+    round-off, on a buckled beam (150 mg standing, its warning carried too)."""
+    s = Scene("pedot-micro", orientation="up", payload="150mg@6.27mm").variant(8, 0.025, "discrete")
+    assert s.choice.buckled
+    ref = rollout(s, "square:1.5V@1Hz", 3.0, drive=make_drive(None, s), sample_interval=0.025, engine="native",
+                  progress=False)
+    got = run_from_states(s, make_drive(None, s), to_waveform("square:1.5V@1Hz", 3.0), 3.0)
+    assert got is not None and len(got.time) == len(ref.time) == 121
+    for k in ("time", "voltage", "tip_position", "tip_angle", "tip_curvature", "centreline", "payload_position"):
+        a, b = getattr(got, k), getattr(ref, k)
+        assert np.max(np.abs(a - b)) <= 1e-12 * np.max(np.abs(b)), k
+    assert sorted(got.signals) == sorted(ref.signals)
+    for k, x in ref.signals.items():
+        assert np.allclose(got.signals[k], x, rtol=1e-12, atol=1e-12 * np.max(np.abs(x))), k
+    assert got.meta["warnings"] == ref.meta["warnings"] == [s.buckled_warning()]
 
 
 def test_batch_members_each_answer_their_metrics():

@@ -102,6 +102,19 @@ class Samples:
         if self.stop is not None:
             self.stop(self)
 
+    def take_all(self, t: np.ndarray, v: np.ndarray, raw: np.ndarray, xmat: np.ndarray,
+                 signals: Dict[str, np.ndarray]) -> None:
+        """All samples at once, as :meth:`take` would have taken them one by one: times (s),
+        voltages, MuJoCo's raw world points (n, clamp + links + tip site [+ payload], 3),
+        the tip body's flattened orientations (n, 9) and the drive's signals (a fixed clamp
+        only)."""
+        if self._moving:
+            raise ValueError("take_all needs a fixed clamp")
+        n = len(t)
+        self.t[:n], self.v[:n], self._raw[:n], self._xmat[:n] = t, v, raw, xmat
+        self.sig = {k: np.asarray(x, float)[:n] for k, x in signals.items()}
+        self.n = n
+
     def clamp_frame(self, idx: np.ndarray):
         """Clamp-frame points (m; clamp, hinges, tip[, payload]) and tip angles (rad) of the
         samples ``idx`` taken so far (copies; the store is left as it is)."""

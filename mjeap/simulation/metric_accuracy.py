@@ -38,7 +38,10 @@ sampled coarser than its step (a user's interval) the sampling's, |q(F) - q(F ev
 sample)| / 3, combined in quadrature. Each run is sampled every step otherwise: the drive
 held over a step puts a square wave's peak one step after its switch, and a grid coarser
 than the step reads the models' peaks unequally (on thick-trilayer's length sweep that hid
-a 0.7 % error from the companions). Where a metric's estimate exceeds the target (or a boolean is undecided), the
+a 0.7 % error from the companions); such a run is read from the states ``mujoco.rollout``
+returns for all its steps (:func:`run_from_states`), not sampled from Python, and a
+refinement reuses the runs already made (its 2 h companion is the last chosen run where it
+halves the step). Where a metric's estimate exceeds the target (or a boolean is undecided), the
 error model e = sqrt((a / N^2)^2 + (b h)^2) takes a and b from the measured parts and a finer
 model is run. Measured numbers: docs/concepts/accuracy.md, scripts/bench.py.
 """
@@ -49,14 +52,17 @@ import time as _time
 from dataclasses import asdict
 from typing import Dict, List, Optional, Sequence
 
+import mujoco
 import numpy as np
+from mujoco import rollout as mj_rollout
 
 from ..errors import ParameterError
 from .accuracy import (SAFETY, ErrorModel, Model, as_error_model, check_accuracy, check_targetable, choose_model,
                        fewer_segments)
 
 __all__ = ["METRIC_SCALES", "check_metrics", "answerable", "relaxed_step_cap", "last_period",
-           "peak_to_peak", "returns_margin", "metric_quantity", "metric_scale", "run_metrics_at_accuracy"]
+           "peak_to_peak", "returns_margin", "metric_quantity", "metric_scale", "run_metrics_at_accuracy",
+           "chain_kinematics", "run_from_states"]
 
 #: the metrics a target may be put on, and the scale each one's error is relative to
 METRIC_SCALES = {"peak_to_peak": "swing", "returns": "margin", "max_stress_proxy": "value",
@@ -84,9 +90,10 @@ START_SEGMENTS = 8
 STEP_RICHARDSON = 1.0
 MAX_REFINEMENTS = 3
 #: cost of a run of a model: RUN_OVERHEAD + steps x (c0 + c1 N) (us; this 2-core machine,
-#: the map's scene: building a variant and a rollout's set-up cost about 25 ms)
-RUN_OVERHEAD_US = 25_000.0
-COST_PER_STEP = (3.0, 0.6)
+#: the map's scene under 'discrete', read from its states (:func:`run_from_states`): building
+#: a variant and its native model about 12 ms, a step of 8 segments 12-15 us, of 16 27-35 us)
+RUN_OVERHEAD_US = 15_000.0
+COST_PER_STEP = (1.0, 1.6)
 #: a model is never chosen with more steps than this (a boolean at its edge falls back to
 #: the scene's own model instead)
 MAX_MODEL_STEPS = 2_000_000
@@ -211,6 +218,118 @@ def _relative(x: float, scale: float) -> float:
     return x / scale if scale > 0 else (0.0 if x == 0 else math.inf)
 
 
+# ---------------------------------------------------------------- a run read from its states
+def _hinge_rotations(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
+    """(n, 3, 3) rotations by ``angle`` (n,) rad about the unit ``axis`` (Rodrigues)."""
+    k = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    s, c = np.sin(angle)[:, None, None], np.cos(angle)[:, None, None]
+    return np.eye(3) + s * k + (1.0 - c) * (k @ k)
+
+
+def chain_kinematics(model, qpos: np.ndarray, bodies: Sequence[int], frame_of: int):
+    """World positions (n, B, 3) of ``bodies`` and orientation (n, 3, 3) of body ``frame_of`` for the joint
+    positions ``qpos`` (n, nq), all samples at once, down a planar chain: each body's frame
+    is a fixed rotation F times a rotation by the summed angle phi of the hinges above it
+    about their one axis, so a point v of a body sits at x + F (v cos phi + (a x v) sin phi
+    + a (a . v)(1 - cos phi)). None where a body moves otherwise (a joint other than one
+    hinge through its origin, hinges on different axes, a rotated body below a hinge)."""
+    n = len(qpos)
+    frame = [(np.eye(3), None, None)]           # per body: F, axis a, phi (n,) (None: not rotating)
+    xpos = [np.zeros((1, 3))]
+    for b in range(1, max(*bodies, frame_of) + 1):
+        p, nj = model.body_parentid[b], model.body_jntnum[b]
+        f, a, phi = frame[p]
+        v = model.body_pos[b]
+        if phi is None:
+            xpos.append(xpos[p] + f @ v)
+        else:
+            c, sn = np.cos(phi)[:, None], np.sin(phi)[:, None]
+            xpos.append(xpos[p] + c * (f @ v) + sn * (f @ np.cross(a, v)) + (1 - c) * (f @ a) * (a @ v))
+        local = np.empty(9)
+        mujoco.mju_quat2Mat(local, model.body_quat[b])
+        local = local.reshape(3, 3)
+        if nj > 1:
+            return None
+        if nj:
+            j = model.body_jntadr[b]
+            if model.jnt_type[j] != mujoco.mjtJoint.mjJNT_HINGE or np.any(model.jnt_pos[j]):
+                return None
+        if phi is not None and (not np.allclose(local, np.eye(3), rtol=0, atol=1e-15) or
+                                (nj and not np.array_equal(model.jnt_axis[model.body_jntadr[b]], a))):
+            return None
+        if not nj:
+            frame.append((f @ local, None, None) if phi is None else (f, a, phi))
+            continue
+        j = model.body_jntadr[b]
+        q = qpos[:, model.jnt_qposadr[j]]
+        frame.append((f @ local, model.jnt_axis[j].copy(), q) if phi is None else (f, a, phi + q))
+    pos = np.stack([np.broadcast_to(xpos[b], (n, 3)) for b in bodies], axis=1)
+    f, a, phi = frame[frame_of]
+    return pos, np.broadcast_to(f, (n, 3, 3)) if phi is None else f @ _hinge_rotations(a, phi)
+
+
+def run_from_states(scene, drive, wave, duration: float, initial_curvature: float = 0.0):
+    """One native run of ``scene`` sampled at every step, its samples read from the states
+    ``mujoco.rollout`` returns (one call, no Python per step; the beam's points by
+    :func:`chain_kinematics`, the drive's signals by its ``native_signal_history``): the
+    RolloutResult the native engine gives sampled every step, at a fraction of the cost. None
+    where that does not apply (no native form, a moving clamp, tip loads, a drive reading
+    its signals one sample at a time, joints other than hinges) or where the run goes bad
+    (the caller then runs it the ordinary way, which says why)."""
+    from ..engines.frame import Samples, voltage_steps
+    from ..engines.native import why_not
+    from ..drives.base import NativeForm
+    from ..engines.threaded import MAXVAL, NATIVE_CONTROL, STATE
+    from ..io.outputs import provenance
+    if why_not(scene, drive) is not None or scene.part.has_tip_load() or \
+            type(drive).native_signal_history is NativeForm.native_signal_history:
+        return None
+    t0 = _time.perf_counter()
+    native = scene.native_model(drive)
+    m, d, part = native.model, native.data, native.part
+    dt = scene.timestep
+    v = voltage_steps(wave, duration, dt, drive)
+    n = len(v)
+    native.reset(initial_curvature)
+    state0 = np.empty(mujoco.mj_stateSize(m, STATE))
+    mujoco.mj_getState(m, d, state0, STATE)
+    control = np.empty(mujoco.mj_stateSize(m, NATIVE_CONTROL))
+    mujoco.mj_getState(m, d, control, NATIVE_CONTROL)
+    drive.native_prepare(v)
+    ctl = np.broadcast_to(control, (1, n, len(control))).copy()
+    ctl[0, :, native.actuator_id] = v
+    states, _ = mj_rollout.rollout(m, d, state0[None], ctl, control_spec=NATIVE_CONTROL, nstep=n)
+    # bad: not finite or beyond mjMAXVAL, or a step on which MuJoCo warned (time stops)
+    if not (np.abs(states[0, :, 1:]) < MAXVAL).all() or not (np.diff(states[0, :, 0]) > 0).all() or \
+            d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number:
+        return None
+    rows = np.concatenate([state0[None], states[0]])
+    steps = np.arange(n + 1)
+    drive.part = part
+    try:
+        sig = drive.native_signal_history(steps, rows, part, native.handles)
+    finally:
+        drive.part = scene.part
+    bodies = [part.clamp_id, *part.link_ids, part.tip_body_id] + ([part.payload_id] if part.payload_id >= 0 else [])
+    kin = chain_kinematics(m, rows[:, 1:1 + m.nq], bodies, part.tip_body_id)
+    if sig is None or kin is None:
+        return None
+    pos, rot = kin
+    N = len(part.link_ids)
+    site = pos[:, N + 1] + rot @ m.site_pos[part.tip_site_id]
+    raw = np.concatenate([pos[:, :N + 1], site[:, None]] + ([pos[:, N + 2:]] if part.payload_id >= 0 else []), axis=1)
+    samples = Samples(part, n + 1)
+    samples.take_all(steps * dt, np.r_[v[0], v], raw, rot.reshape(-1, 9), sig)
+    meta = {**provenance(), "actuator": scene.actuator.id, "drive": drive.describe(),
+            "voltage": getattr(wave, "text", str(wave)), "duration_s": duration,
+            "initial_curvature_per_m": initial_curvature, "steps": n,
+            "engine": "native (every step read from mujoco.rollout's states)", "scene": scene.summary(),
+            "wall_time_s": _time.perf_counter() - t0}
+    if scene.choice.buckled:
+        meta["warnings"] = [scene.buckled_warning()]
+    return samples.result(drive, initial_curvature, meta)
+
+
 # ---------------------------------------------------------------- the choice
 def _cost(model: Model, duration: float) -> float:
     c0, c1 = COST_PER_STEP
@@ -281,11 +400,13 @@ def _needs(metrics: Dict[str, dict], target: float) -> float:
 
 
 def run_metrics_at_accuracy(scene, run, *, metrics: Sequence[str], accuracy: float, duration: float, drive,
-                            wave=None, sample_interval: Optional[float] = None, error_model=None):
+                            wave=None, sample_interval: Optional[float] = None, error_model=None, every_step=None):
     """Choose, run and check a model of ``scene`` whose ``metrics`` (names of
     :data:`METRIC_SCALES`) are within ``accuracy`` of their scales. ``run(scene, interval)``
     runs one model sampled every ``interval`` s (None: every step) and returns a
-    RolloutResult; ``drive`` (the question's drive) bounds the relaxed step. ``error_model``:
+    RolloutResult; ``every_step(scene)``, where given, runs one sampled every step the faster
+    way (:func:`run_from_states`; None where that does not apply: ``run`` then runs it);
+    ``drive`` (the question's drive) bounds the relaxed step. ``error_model``:
     (a, b) of a similar question (a sweep's earlier point) choosing the first model. Returns
     (result, scene of the chosen model, report), the report also in
     ``result.meta['accuracy']`` with one entry per metric under ``'metrics'``."""
@@ -307,26 +428,55 @@ def run_metrics_at_accuracy(scene, run, *, metrics: Sequence[str], accuracy: flo
     grid = period / SAMPLES_PER_PERIOD if own_grid else (sample_interval or duration)
     h_cap = min(h_cap, grid)
     log: List[dict] = []
+    done: Dict[tuple, tuple] = {}        # (model, interval) -> (scene, result): a refinement's companions reuse them
 
     def one(model: Model, role: str, interval=None):
+        if (model, interval) in done:
+            log.append({"role": role + " (reused)", **asdict(model), "wall_time_s": 0.0})
+            return done[model, interval]
         s = scene.variant(model.segments, model.timestep, model.integrator)
         t = _time.perf_counter()
-        out = run(s, interval)
+        out = every_step(s) if every_step is not None and interval == model.timestep else None
+        if out is None:
+            out = run(s, interval)
         log.append({"role": role, **asdict(model), "wall_time_s": _time.perf_counter() - t})
+        done[model, interval] = s, out
         return s, out
 
-    def attempt(model: Model, role: str):
-        chosen, f = one(model, role, sample_interval or model.timestep)
-        n_s = fewer_segments(model.segments)
+    def runs_of(model: Model) -> list:
+        """The runs an attempt at ``model`` needs: it and its two companions."""
         h2 = 2 * model.timestep
-        every = sample_interval or h2
-        _, mid = one(Model(model.segments, h2, model.integrator), "companion", every)
-        _, fewer = one(Model(n_s, h2, model.integrator), "spatial companion", every)
-        return chosen, f, _evaluate(names, ((f, mid, fewer), (model.segments, n_s)), period, duration,
+        return [(model, sample_interval or model.timestep),
+                (Model(model.segments, h2, model.integrator), sample_interval or h2),
+                (Model(fewer_segments(model.segments), h2, model.integrator), sample_interval or h2)]
+
+    def new_cost(model: Model) -> float:
+        """The cost of an attempt at ``model``, less the runs already done."""
+        return sum(_cost(m, duration) for m, i in runs_of(model) if (m, i) not in done)
+
+    def refine(em: ErrorModel, need: float, last: Model) -> Model:
+        """The cheapest next model by the error model: :func:`_choose`'s, or ``last``'s
+        segments at an integer fraction of its step (its runs then serve as companions)."""
+        best = _choose(scene, em, need, duration, grid, h_cap)
+        for k in (2, 3, 4, 6, 8):
+            m = Model(last.segments, last.timestep / k, last.integrator)
+            if em.predict(m) <= need / SAFETY and _integrator(scene, m.timestep) == last.integrator and \
+                    new_cost(m) < new_cost(best):
+                best = m
+        return best
+
+    def attempt(model: Model, role: str):
+        (m_f, i_f), (m_mid, i_mid), (m_s, i_s) = runs_of(model)
+        chosen, f = one(m_f, role, i_f)
+        _, mid = one(m_mid, "companion", i_mid)
+        _, fewer = one(m_s, "spatial companion", i_s)
+        return chosen, f, _evaluate(names, ((f, mid, fewer), (model.segments, m_s.segments)), period, duration,
                                     model.timestep)
 
-    if given is not None:
+    if given is not None:       # not below START_SEGMENTS: a family's first point (its lightest load, on the
+        # map) predicts too few for the rest (from 4 segments 13 of the map's 23 other points were refined)
         model = _choose(scene, given, target, duration, grid, h_cap)
+        model = Model(max(model.segments, START_SEGMENTS), model.timestep, model.integrator)
     else:
         h0 = _on_grid(h_cap, grid / 2)
         model = Model(START_SEGMENTS, h0, _integrator(scene, h0))
@@ -337,7 +487,7 @@ def run_metrics_at_accuracy(scene, run, *, metrics: Sequence[str], accuracy: flo
     while need > 0 and refinements < MAX_REFINEMENTS:
         em = ErrorModel(max(max(m["segments_error"] for m in found.values()) * model.segments ** 2, 1e-12),
                         max(max(m["step_error"] for m in found.values()) / model.timestep, 1e-12))
-        nxt = _choose(scene, em, need, duration, grid, h_cap)
+        nxt = refine(em, need, model)
         if duration / nxt.timestep > MAX_MODEL_STEPS or \
                 (nxt.segments <= model.segments and nxt.timestep >= model.timestep):
             break

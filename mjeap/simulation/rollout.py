@@ -48,12 +48,6 @@ def _meta(scene, drv, wave, duration, initial_curvature) -> dict:
             "drive_parameters": {k: [v, drv.sources.get(k, "")] for k, v in drv.params.items()}}
 
 
-#: the warning of a run whose straight beam is unstable under gravity ({} the actuator)
-BUCKLED = ("{}: the straight beam is unstable under gravity (the payload is above the column load): the run starts "
-           "from that unstable equilibrium and only a disturbance (an initial curvature, a voltage) makes it buckle; "
-           "a result near zero here is not a stable beam")
-
-
 @guarded("rrd", "csv_path")
 def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: float,
             drive: Union[str, "object", None] = None, drive_params: Optional[dict] = None,
@@ -130,7 +124,7 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     if stop_when_periodic is not None:
         samples.stop = PeriodicStop(period, stop_tol, scene.layout.length)
     if scene.choice.buckled:
-        p.meta.setdefault("warnings", []).append(BUCKLED.format(scene.actuator.id))
+        p.meta.setdefault("warnings", []).append(scene.buckled_warning())
     if controller is not None:
         p.meta["controller"] = ctrl_name
     return execute(p.meta, lambda: run_checked(eng, scene, [drv], p.v_steps, [initial_curvature], p.sample_steps,
@@ -160,10 +154,14 @@ def _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, 
                        stop_when_periodic=stop)
 
     if target is not None and metrics:
-        from .metric_accuracy import run_metrics_at_accuracy
+        from .metric_accuracy import run_from_states, run_metrics_at_accuracy
+        every_step = None       # each run sampled every step, read from its states where that applies
+        if controller is None and engine in ("auto", "native") and stop_when_periodic is None and max_steps is None:
+            def every_step(s):
+                return run_from_states(s, type(drv)(s, **params), wave, duration, initial_curvature)
         result, chosen, _ = run_metrics_at_accuracy(scene, run, metrics=metrics, accuracy=target, duration=duration,
                                                     drive=drv, wave=wave, sample_interval=sample_interval,
-                                                    error_model=error_model)
+                                                    error_model=error_model, every_step=every_step)
     elif target is None:
         chosen = scene
         result = run(scene, sample_interval)

@@ -308,6 +308,12 @@ class Scene:
         u = self.units
         return self.rayleigh_share(timestep, choice) * self.layout.hinge_stiffness / u.rotational_stiffness
 
+    def buckled_warning(self) -> str:
+        """A run's warning where the straight beam is unstable under gravity (``choice.buckled``)."""
+        return (f"{self.actuator.id}: the straight beam is unstable under gravity (the payload is above the column "
+                "load): the run starts from that unstable equilibrium and only a disturbance (an initial curvature, "
+                "a voltage) makes it buckle; a result near zero here is not a stable beam")
+
     def rayleigh_share(self, timestep: float, choice: Optional[TimestepChoice] = None) -> float:
         """The beam's own stiffness-proportional damping coefficient (internal time) when
         stepped at ``timestep`` (s): beta, less the h that an integrator taking the stiffness
