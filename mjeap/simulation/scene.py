@@ -135,6 +135,11 @@ class _BeamAnalysis:
     beta: float                   # Rayleigh beta
     h_stab: float                 # stability limit under the integrator (inf: none)
 
+    def nbytes(self) -> int:
+        """Memory held by its matrices (bytes)."""
+        return self.pattern.nbytes + sum(getattr(self.linearization, k).nbytes
+                                         for k in ("M", "K_elastic", "K_gravity", "K_joint"))
+
 
 #: the timestep-independent analysis of a scene (linearisation, modes, Rayleigh beta and
 #: stability limit: two thirds of building one), keyed on everything that determines it,
@@ -142,8 +147,10 @@ class _BeamAnalysis:
 #: representation, segments, orientation, payload, units, gravity, damping ratio,
 #: integrator and max_bend. An accuracy target's models of one beam at different steps, and
 #: a sweep's points that differ only in their drive, share it. Oldest dropped past ANALYSIS_CACHE_SIZE
+#: entries or ANALYSIS_CACHE_BYTES of matrices (a 1000-segment beam's take ~30 MB)
 _ANALYSES: "OrderedDict[tuple, _BeamAnalysis]" = OrderedDict()
 ANALYSIS_CACHE_SIZE = 256
+ANALYSIS_CACHE_BYTES = 64 * 2**20
 
 
 def clear_build_caches() -> None:
@@ -238,7 +245,8 @@ class Scene:
         if a is None or a.actuator is not self.actuator:
             a = self._analyse(zeta)
             _ANALYSES[key] = a
-            if len(_ANALYSES) > ANALYSIS_CACHE_SIZE:
+            while len(_ANALYSES) > 1 and (len(_ANALYSES) > ANALYSIS_CACHE_SIZE or
+                                          sum(map(_BeamAnalysis.nbytes, _ANALYSES.values())) > ANALYSIS_CACHE_BYTES):
                 _ANALYSES.popitem(last=False)
         else:
             _ANALYSES.move_to_end(key)
