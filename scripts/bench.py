@@ -530,11 +530,13 @@ def bench_metric_map(masses=(20, 40, 60, 70, 74, 78, 82, 100), amplitudes=(0.25,
     """The stability map (pedot-micro standing, 30 s points) at accuracy 1e-2 on its metrics
     (returns, peak_to_peak: mjeap.simulation.metric_accuracy, relaxed steps) against the
     default model on the same points, serial and on 2 workers, interleaved in ``rounds``
-    rounds (the machine is shared): points per second, their ratio, returns agreement, the
+    rounds (the machine is shared), each run from cold (the scenes' shared analyses cleared):
+    points per second, their ratio, returns agreement, the
     largest peak-to-peak deviation from the default, the simulated edges; and where the time
     of an accuracy point goes (its runs)."""
     import tempfile
     from mjeap.analysis.stability import MAP_BASE, simulated_edges
+    from mjeap.simulation.scene import clear_build_caches
     from mjeap.sweep import grid, read_results, run_sweep
     pts = grid(payload_mass=[m * 1e-6 for m in masses], amplitude=list(amplitudes))
     out = {"case": f"stability map points ({len(pts)}: {', '.join(map(str, masses))} mg x {amplitudes} V; the "
@@ -548,6 +550,7 @@ def bench_metric_map(masses=(20, 40, 60, 70, 74, 78, 82, 100), amplitudes=(0.25,
                 for label, extra in (("default", {}), ("accuracy_1e-2", {"accuracy": 1e-2})):
                     key = f"{executor}_{workers}_{label}"
                     path = Path(d) / f"{key}_{k}.csv"
+                    clear_build_caches()    # each run from cold: no analysis or layout from the one before
                     res = run_sweep(pts, path, metrics=("returns", "peak_to_peak"), base={**MAP_BASE, **extra},
                                     executor=executor, workers=workers, progress=False)
                     walls.setdefault(key, []).append(res.wall_s)

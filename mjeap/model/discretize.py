@@ -10,6 +10,7 @@ and converges at first order only).
 """
 from __future__ import annotations
 
+from collections import OrderedDict
 from dataclasses import dataclass
 import re
 from typing import Optional, Tuple
@@ -200,6 +201,36 @@ def discretize(act: Actuator, segments: int) -> BeamLayout:
         extension_length=act.planform.extension_length, extension_mass=act.planform.tip_block_mass,
         poisson_ratio=nu,
     )
+
+
+#: layouts already built, keyed on the actuator object (held in the entry, so its id stays
+#: its own while cached; actuators are frozen) and the segment count: a sweep's or an
+#: accuracy target's many models of one actuator share them. Oldest dropped past LAYOUT_CACHE_SIZE
+_LAYOUTS: "OrderedDict[tuple, tuple]" = OrderedDict()
+LAYOUT_CACHE_SIZE = 64
+
+
+def shared_layout(act: Actuator, segments: int) -> BeamLayout:
+    """:func:`discretize` of ``act`` with ``segments`` hinges, built once per actuator object
+    and segment count and shared (its arrays read-only): the same layout, bit for bit."""
+    key = (id(act), segments)
+    hit = _LAYOUTS.get(key)
+    if hit is not None and hit[0] is act:
+        _LAYOUTS.move_to_end(key)
+        return hit[1]
+    layout = discretize(act, segments)
+    for value in layout.__dict__.values():
+        if isinstance(value, np.ndarray):
+            value.flags.writeable = False
+    _LAYOUTS[key] = (act, layout)
+    if len(_LAYOUTS) > LAYOUT_CACHE_SIZE:
+        _LAYOUTS.popitem(last=False)
+    return layout
+
+
+def clear_layouts() -> None:
+    """Forget the layouts :func:`shared_layout` holds (a benchmark's cold start)."""
+    _LAYOUTS.clear()
 
 
 def check_payload(payload: Optional[Payload], layout: BeamLayout) -> None:

@@ -226,6 +226,9 @@ def _hinge_rotations(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
     return np.eye(3) + s * k + (1.0 - c) * (k @ k)
 
 
+_EYE = np.eye(3)
+
+
 def chain_kinematics(model, qpos: np.ndarray, bodies: Sequence[int], frame_of: int):
     """World positions (n, B, 3) of ``bodies`` and orientation (n, 3, 3) of body ``frame_of`` for the joint
     positions ``qpos`` (n, nq), all samples at once, down a planar chain: each body's frame
@@ -244,7 +247,8 @@ def chain_kinematics(model, qpos: np.ndarray, bodies: Sequence[int], frame_of: i
             xpos.append(xpos[p] + f @ v)
         else:
             c, sn = np.cos(phi)[:, None], np.sin(phi)[:, None]
-            xpos.append(xpos[p] + c * (f @ v) + sn * (f @ np.cross(a, v)) + (1 - c) * (f @ a) * (a @ v))
+            axv = np.array([a[1] * v[2] - a[2] * v[1], a[2] * v[0] - a[0] * v[2], a[0] * v[1] - a[1] * v[0]])
+            xpos.append(xpos[p] + c * (f @ v) + sn * (f @ axv) + (1 - c) * (f @ a) * (a @ v))
         local = np.empty(9)
         mujoco.mju_quat2Mat(local, model.body_quat[b])
         local = local.reshape(3, 3)
@@ -254,7 +258,7 @@ def chain_kinematics(model, qpos: np.ndarray, bodies: Sequence[int], frame_of: i
             j = model.body_jntadr[b]
             if model.jnt_type[j] != mujoco.mjtJoint.mjJNT_HINGE or np.any(model.jnt_pos[j]):
                 return None
-        if phi is not None and (not np.allclose(local, np.eye(3), rtol=0, atol=1e-15) or
+        if phi is not None and (not np.abs(local - _EYE).max() <= 1e-15 or
                                 (nj and not np.array_equal(model.jnt_axis[model.body_jntadr[b]], a))):
             return None
         if not nj:

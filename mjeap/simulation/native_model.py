@@ -2,6 +2,9 @@
 engine (:mod:`mjeap.engines.native`) steps."""
 from __future__ import annotations
 
+import hashlib
+from collections import OrderedDict
+
 import mujoco
 import numpy as np
 
@@ -12,6 +15,26 @@ from ..model.fields import add_units, apply_dof_damping
 from ..model.modes import linearize, spectral_radius
 
 __all__ = ["NativeModel"]
+
+#: native models found stable, keyed on their content: a digest of the compiled model's
+#: MJB bytes (every number MuJoCo steps with: timestep, masses, stiffness, damping, the
+#: drive's elements) and the integrator. The same model built again (an accuracy target's
+#: model at the next point of a sweep, another amplitude) skips the check, whose answer it
+#: already has. Oldest dropped past STABLE_CACHE_SIZE
+_STABLE: "OrderedDict[tuple, None]" = OrderedDict()
+STABLE_CACHE_SIZE = 512
+
+
+def clear_stable() -> None:
+    """Forget which native models were found stable."""
+    _STABLE.clear()
+
+
+def _content_key(model: mujoco.MjModel, integrator: str) -> tuple:
+    """A digest of ``model``'s MJB bytes, with ``integrator``: equal only for the same model."""
+    buf = np.empty(mujoco.mj_sizeModel(model), np.uint8)
+    mujoco.mj_saveModel(model, None, buf)
+    return hashlib.blake2b(buf.tobytes(), digest_size=16).digest(), integrator
 
 
 class NativeModel:
@@ -44,12 +67,20 @@ class NativeModel:
 
     def check_stability(self) -> None:
         """The scene chose its timestep for the bare beam; the drive's elements (Maxwell arms)
-        must not make the linearised step map unstable at that timestep."""
+        must not make the linearised step map unstable at that timestep (a model already
+        found stable, by its content, is not checked again)."""
+        key = _content_key(self.model, self.scene.integrator)
+        if key in _STABLE:
+            _STABLE.move_to_end(key)
+            return
         lin = linearize(self.model)
         rho = spectral_radius(lin, self.model.dof_damping, self.model.opt.timestep, self.scene.integrator)
         if rho > 1.0 + 1e-9:
             raise ParameterError("timestep", self.scene.timestep, "a timestep at which the native drive is stable",
                                  f"spectral radius {rho:.6g} of the native model's step map")
+        _STABLE[key] = None
+        if len(_STABLE) > STABLE_CACHE_SIZE:
+            _STABLE.popitem(last=False)
 
     def reset(self, initial_curvature: float = 0.0) -> None:
         """Rest at a uniform arc of ``initial_curvature`` (1/m), the drive state at rest there;

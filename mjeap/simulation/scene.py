@@ -44,6 +44,7 @@ from __future__ import annotations
 
 import math
 import warnings
+from collections import OrderedDict
 from dataclasses import dataclass
 from typing import Optional, Union
 
@@ -54,7 +55,7 @@ import scipy.linalg
 from .accuracy import check_accuracy
 from ..errors import DivergenceError, ParameterError, check_positive, check_range
 from ..model.catalog import Actuator, get_actuator
-from ..model.discretize import BeamLayout, Payload, check_payload, clamp_rotation, discretize
+from ..model.discretize import BeamLayout, Payload, check_payload, clamp_rotation, clear_layouts, shared_layout
 from ..model.fields import apply_dof_damping
 from ..model.mjcf import build_spec, get_builder
 from ..model.modes import modal_frequencies, stability_limit
@@ -120,6 +121,47 @@ class TimestepChoice:
         return dict(self.__dict__)
 
 
+@dataclass(frozen=True)
+class _BeamAnalysis:
+    """What a scene's timestep and damping are chosen from, the timestep aside (internal units)."""
+
+    actuator: Actuator            # held: its id in the key stays its own while cached
+    linearization: object         # mjeap.model.modes.Linearization of the spec as built
+    w_el: float                   # first elastic mode (rad per time unit), gravity's load left out
+    wmax: float                   # highest elastic mode
+    w1: float                     # first mode's rate, gravity included (floored)
+    buckled: bool
+    pattern: np.ndarray           # Rayleigh damping per dof per unit beta
+    beta: float                   # Rayleigh beta
+    h_stab: float                 # stability limit under the integrator (inf: none)
+
+    def nbytes(self) -> int:
+        """Memory held by its matrices (bytes)."""
+        return self.pattern.nbytes + sum(getattr(self.linearization, k).nbytes
+                                         for k in ("M", "K_elastic", "K_gravity", "K_joint"))
+
+
+#: the timestep-independent analysis of a scene (linearisation, modes, Rayleigh beta and
+#: stability limit: two thirds of building one), keyed on everything that determines it,
+#: ``Scene.build_key``: the actuator object (held, so its id is not reused while cached),
+#: representation, segments, orientation, payload, units, gravity, damping ratio,
+#: integrator and max_bend. An accuracy target's models of one beam at different steps, and
+#: a sweep's points that differ only in their drive, share it. Oldest dropped past ANALYSIS_CACHE_SIZE
+#: entries or ANALYSIS_CACHE_BYTES of matrices (a 1000-segment beam's take ~30 MB)
+_ANALYSES: "OrderedDict[tuple, _BeamAnalysis]" = OrderedDict()
+ANALYSIS_CACHE_SIZE = 256
+ANALYSIS_CACHE_BYTES = 64 * 2**20
+
+
+def clear_build_caches() -> None:
+    """Forget the analyses, layouts and native models' stability that scenes share (a
+    benchmark's cold start)."""
+    from .native_model import clear_stable
+    _ANALYSES.clear()
+    clear_layouts()
+    clear_stable()
+
+
 class Scene:
     """A catalog actuator as a MuJoCo scene. Inputs and outputs in SI.
 
@@ -171,7 +213,7 @@ class Scene:
         self.representation, self.orientation, self.payload = representation, orientation, payload
         self.integrator = integrator
         self.max_bend = check_range("max_bend", max_bend, 0.0, 2 * np.pi, "rad")
-        self.layout: BeamLayout = discretize(self.actuator, segments)
+        self.layout: BeamLayout = shared_layout(self.actuator, segments)
         check_payload(payload, self.layout)
         beam_mass = float(self.layout.link_mass.sum())
         if payload is not None:
@@ -194,50 +236,26 @@ class Scene:
     # ------------------------------------------------------------------ construction
     def _choose_timestep_and_damping(self, zeta: float, timestep: Optional[float]) -> TimestepChoice:
         u = self.units
-        try:
-            model = self.spec.compile()
-        except ValueError as e:
-            if "mjMINVAL" not in str(e):
-                raise
-            raise ParameterError(
-                "units", u, "units in which segment masses and inertias exceed MuJoCo's 1e-15 floor",
-                f"{self.actuator.id}: smallest segment mass {self.layout.link_mass.min() / u.mass:.3g} and "
-                f"inertia {self.layout.link_inertia.min() / u.inertia:.3g} in these units; use e.g. the default "
-                f"(mm, mg, ms). MuJoCo said: {str(e).splitlines()[0]}") from None
         b, hd, lay = self.builder, self.handles, self.layout
-        self.linearization = lin = b.linearize(model, hd, lay, u)
-        lam, phi = scipy.linalg.eigh(lin.K, lin.M)       # gravity included, mass-normalised
-        w2_el = modal_frequencies(lin, with_gravity=False)
-        buckled = bool(lam[0] <= 0)
-        w_el, wmax = np.sqrt(w2_el[0]), np.sqrt(w2_el[-1])
-        # the first mode's rate: its frequency below the buckling load, the growth rate of
-        # the straight column's unstable mode above it (near the load both go to zero like
-        # sqrt|1 - P/P_cr|, so nothing jumps there), floored at NEAR_CRITICAL x w_el
-        w1 = max(np.sqrt(abs(lam[0])), NEAR_CRITICAL * w_el)
-        # Rayleigh damping D = beta K_el per degree of freedom (clipped diagonal: a ball joint
-        # takes one scalar damping in MJCF, so the cable's per-dof values (bending, in-plane,
-        # twist) travel in a custom numeric field that load_mjcf() and the scene apply after
-        # compiling). The first mode phi_1 of K = K_el + K_gravity gets the modal damping
-        # beta phi_1' D_1 phi_1 = 2 zeta w1 with D_1 the pattern per unit beta, so beta is
-        # taken from that: with gravity's geometric stiffness in the frequency but not in
-        # the damping, 2 zeta / w1 would give zeta (w_el / w1)^2 (0.16 standing up, 0.03
-        # hanging with 100 mg on seed 000's beam).
-        pattern = np.clip(np.diag(lin.K_elastic), 0.0, None)
-        k1 = float(phi[:, 0] @ (pattern * phi[:, 0]))
-        beta = 2 * zeta * w1 / k1
-        dof_damping = beta * pattern
+        o = self.orientation if isinstance(self.orientation, str) else self.rotation.tobytes()
+        #: everything this scene's model was built from (the actuator by identity: see _ANALYSES)
+        self.build_key = key = (id(self.actuator), self.representation, lay.segments, o, self.payload, u,
+                                self._arguments["gravity"], zeta, self.integrator, self.max_bend)
+        a = _ANALYSES.get(key)
+        if a is None or a.actuator is not self.actuator:
+            a = self._analyse(zeta)
+            _ANALYSES[key] = a
+            while len(_ANALYSES) > 1 and (len(_ANALYSES) > ANALYSIS_CACHE_SIZE or
+                                          sum(map(_BeamAnalysis.nbytes, _ANALYSES.values())) > ANALYSIS_CACHE_BYTES):
+                _ANALYSES.popitem(last=False)
+        else:
+            _ANALYSES.move_to_end(key)
+        self.linearization = a.linearization
+        w_el, wmax, w1, buckled, beta, h_stab = a.w_el, a.wmax, a.w1, a.buckled, a.beta, a.h_stab
         kj = lay.hinge_stiffness / u.rotational_stiffness
-        b.set_damping(self.spec, hd, beta, beta * kj, dof_damping if b.stores_dof_damping else None)
+        b.set_damping(self.spec, hd, beta, beta * kj, beta * a.pattern if b.stores_dof_damping else None)
         T1, T_el = 2 * np.pi / w1, 2 * np.pi / w_el
         T_short = min(T1, T_el)
-        h_stab = stability_limit(lin, dof_damping, self.integrator, h_max=T_short)
-        if b.check_bent_stability:
-            # the cable's tangent stiffness stops being diagonal in the joint coordinates
-            # once bent (the stiff in-plane direction couples into twist), so diagonal
-            # damping no longer damps it: check the design bend too
-            bent = np.full(lay.segments, self.max_bend / lay.segments)
-            h_stab = min(h_stab, stability_limit(b.linearize(model, hd, lay, u, angles=bent), dof_damping,
-                                                 self.integrator, h_max=T_short))
         # accuracy: 50 steps per period of the first mode, and of the first mode without
         # gravity's load (near the buckling load T1 grows without bound, the beam's elastic
         # response to a drive or a push does not). The drives are discretised exactly
@@ -288,6 +306,53 @@ class Scene:
             b.set_damping(self.spec, hd, self.rayleigh_share(h * u.time, choice), self.joint_damping(h * u.time, choice))
         b.finish(self.spec, hd, h)
         return choice
+
+    def _analyse(self, zeta: float) -> "_BeamAnalysis":
+        """The timestep-independent part of the choice: linearisation, modes, Rayleigh beta and
+        the stability limit of the spec as built (no damping yet)."""
+        u = self.units
+        try:
+            model = self.spec.compile()
+        except ValueError as e:
+            if "mjMINVAL" not in str(e):
+                raise
+            raise ParameterError(
+                "units", u, "units in which segment masses and inertias exceed MuJoCo's 1e-15 floor",
+                f"{self.actuator.id}: smallest segment mass {self.layout.link_mass.min() / u.mass:.3g} and "
+                f"inertia {self.layout.link_inertia.min() / u.inertia:.3g} in these units; use e.g. the default "
+                f"(mm, mg, ms). MuJoCo said: {str(e).splitlines()[0]}") from None
+        b, hd, lay = self.builder, self.handles, self.layout
+        lin = b.linearize(model, hd, lay, u)
+        lam, phi = scipy.linalg.eigh(lin.K, lin.M)       # gravity included, mass-normalised
+        w2_el = modal_frequencies(lin, with_gravity=False)
+        buckled = bool(lam[0] <= 0)
+        w_el, wmax = np.sqrt(w2_el[0]), np.sqrt(w2_el[-1])
+        # the first mode's rate: its frequency below the buckling load, the growth rate of
+        # the straight column's unstable mode above it (near the load both go to zero like
+        # sqrt|1 - P/P_cr|, so nothing jumps there), floored at NEAR_CRITICAL x w_el
+        w1 = max(np.sqrt(abs(lam[0])), NEAR_CRITICAL * w_el)
+        # Rayleigh damping D = beta K_el per degree of freedom (clipped diagonal: a ball joint
+        # takes one scalar damping in MJCF, so the cable's per-dof values (bending, in-plane,
+        # twist) travel in a custom numeric field that load_mjcf() and the scene apply after
+        # compiling). The first mode phi_1 of K = K_el + K_gravity gets the modal damping
+        # beta phi_1' D_1 phi_1 = 2 zeta w1 with D_1 the pattern per unit beta, so beta is
+        # taken from that: with gravity's geometric stiffness in the frequency but not in
+        # the damping, 2 zeta / w1 would give zeta (w_el / w1)^2 (0.16 standing up, 0.03
+        # hanging with 100 mg on seed 000's beam).
+        pattern = np.clip(np.diag(lin.K_elastic), 0.0, None)
+        k1 = float(phi[:, 0] @ (pattern * phi[:, 0]))
+        beta = 2 * zeta * w1 / k1
+        dof_damping = beta * pattern
+        T_short = min(2 * np.pi / w1, 2 * np.pi / w_el)
+        h_stab = stability_limit(lin, dof_damping, self.integrator, h_max=T_short)
+        if b.check_bent_stability:
+            # the cable's tangent stiffness stops being diagonal in the joint coordinates
+            # once bent (the stiff in-plane direction couples into twist), so diagonal
+            # damping no longer damps it: check the design bend too
+            bent = np.full(lay.segments, self.max_bend / lay.segments)
+            h_stab = min(h_stab, stability_limit(b.linearize(model, hd, lay, u, angles=bent), dof_damping,
+                                                 self.integrator, h_max=T_short))
+        return _BeamAnalysis(self.actuator, lin, w_el, wmax, w1, buckled, pattern, beta, h_stab)
 
     def check_timestep(self, timestep: float, name: str = "timestep") -> float:
         """``timestep`` (s), refused with the limit and its reason where this beam would not
