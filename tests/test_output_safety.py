@@ -145,6 +145,7 @@ def test_a_second_writer_of_an_output_is_refused_before_any_work(tmp_path, monke
         assert main(["rollout", "pedot-micro", "--voltage", "step:1V", "--duration", "0.01",
                      "--rrd", str(rrd)]) == 2
     finally:
+        time.sleep(0.5)         # as the SIGTERM test: the first run simulates a while (the checks above can be quick)
         p.send_signal(signal.SIGTERM)
         p.communicate(timeout=60)
     # the first run's outputs are whole
