@@ -75,7 +75,7 @@ def test_controller_and_tip_load_are_refused():
     with pytest.raises(ParameterError, match="engine"):
         rollout(s, "step:120V", 1e-3, engine="threaded")
     with pytest.raises(ParameterError, match="engine"):
-        rollout(s, "step:120V", 1e-3, engine="warp")
+        rollout(s, "step:120V", 1e-3, engine="no-such-engine")     # an unknown engine, refused by name
 
 
 def test_batch_on_two_threads_equals_one_by_one():
