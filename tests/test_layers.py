@@ -103,17 +103,21 @@ def _dynamic_import(node, module: str, package: str):
         yield from (m for m in MODULES if re.fullmatch(pattern, m))
 
 
+def _import_source(node: ast.ImportFrom, package: str) -> str:
+    """The absolute module a ``from ... import`` names, relative levels resolved in ``package``."""
+    if not node.level:
+        return node.module or ""
+    base = package.split(".")[:len(package.split(".")) - (node.level - 1)]
+    return ".".join(base + ([node.module] if node.module else []))
+
+
 def _imports(module: str, path: Path, source: str = None):
     """The mjeap modules ``module`` imports anywhere in its file (lazy imports included, and
     the modules its ``importlib.import_module`` calls name)."""
     package = module if path.name == "__init__.py" else module.rpartition(".")[0]
     for node in ast.walk(ast.parse(path.read_text() if source is None else source)):
         if isinstance(node, ast.ImportFrom):
-            if node.level:
-                base = package.split(".")[:len(package.split(".")) - (node.level - 1)]
-                src = ".".join(base + ([node.module] if node.module else []))
-            else:
-                src = node.module or ""
+            src = _import_source(node, package)
             for a in node.names:
                 if f"{src}.{a.name}" in MODULES:
                     yield f"{src}.{a.name}"
@@ -140,11 +144,7 @@ def _unresolved(module: str, path: Path):
     package = module if path.name == "__init__.py" else module.rpartition(".")[0]
     for node in ast.walk(ast.parse(path.read_text())):
         if isinstance(node, ast.ImportFrom):
-            if node.level:
-                base = package.split(".")[:len(package.split(".")) - (node.level - 1)]
-                src = ".".join(base + ([node.module] if node.module else []))
-            else:
-                src = node.module or ""
+            src = _import_source(node, package)
             if src.split(".")[0] == "mjeap" and src not in MODULES:
                 yield f"{module}: from {'.' * node.level}{node.module or ''} ({src})"
         elif isinstance(node, ast.Import):
