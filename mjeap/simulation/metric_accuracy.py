@@ -62,7 +62,7 @@ from .accuracy import (SAFETY, ErrorModel, Model, as_error_model, check_accuracy
 
 __all__ = ["METRIC_SCALES", "check_metrics", "answerable", "relaxed_step_cap", "last_period",
            "peak_to_peak", "returns_margin", "metric_quantity", "metric_scale", "run_metrics_at_accuracy",
-           "chain_kinematics", "run_from_states"]
+           "chain_kinematics", "run_from_states", "TipPath", "reported_value"]
 
 #: the metrics a target may be put on, and the scale each one's error is relative to
 METRIC_SCALES = {"peak_to_peak": "swing", "returns": "margin", "max_stress_proxy": "value",
@@ -89,6 +89,14 @@ START_SEGMENTS = 8
 #: the true error): 3 x high where the order is 2
 STEP_RICHARDSON = 1.0
 MAX_REFINEMENTS = 3
+#: Richardson extrapolation of a relaxed run's metrics (order 1 -> 2, :func:`_extrapolate`):
+#: where the observed order from the runs at h, 2 h and 4 h, log2(d2 / d1), lies in this window
+EXTRAPOLATION_ORDERS = (0.7, 1.4)
+#: the extrapolated value's step error is taken as at least this fraction of the correction
+#: it made: three steps see the h^2 term, not where the relaxed branch's limit (its fast modes
+#: overdamped) differs from the resolved solution (measured on the map's points near the
+#: column load, 70-82 mg at 25 ms against runs at 0.5 and 1 ms: 0.06-0.075 of it)
+EXTRAPOLATION_FLOOR = 0.1
 #: cost of a run of a model: RUN_OVERHEAD + steps x (c0 + c1 N) (us; this 2-core machine,
 #: the map's scene under 'discrete', read from its states (:func:`run_from_states`): building
 #: a variant and its native model about 12 ms, a step of 8 segments 12-15 us, of 16 27-35 us)
@@ -272,11 +280,22 @@ def chain_kinematics(model, qpos: np.ndarray, bodies: Sequence[int], frame_of: i
     return pos, np.broadcast_to(f, (n, 3, 3)) if phi is None else f @ _hinge_rotations(a, phi)
 
 
-def run_from_states(scene, drive, wave, duration: float, initial_curvature: float = 0.0):
+class TipPath:
+    """What a companion run gives the metrics: ``time`` (s), ``tip_position`` (n, 3; m,
+    clamp frame) and ``tip_curvature`` (1/m), read as a RolloutResult reads them."""
+
+    def __init__(self, time: np.ndarray, tip_position: np.ndarray):
+        from ..model.analytical import arc_curvature
+        self.time, self.tip_position = time, tip_position
+        self.tip_curvature = arc_curvature(tip_position[:, 0], tip_position[:, 1])
+
+
+def run_from_states(scene, drive, wave, duration: float, initial_curvature: float = 0.0, tip_only: bool = False):
     """One native run of ``scene`` sampled at every step, its samples read from the states
     ``mujoco.rollout`` returns (one call, no Python per step; the beam's points by
     :func:`chain_kinematics`, the drive's signals by its ``native_signal_history``): the
-    RolloutResult the native engine gives sampled every step, at a fraction of the cost. None
+    RolloutResult the native engine gives sampled every step, at a fraction of the cost
+    (``tip_only``: a :class:`TipPath`, the tip alone, what a companion's metrics read). None
     where that does not apply (no native form, a moving clamp, tip loads, a drive reading
     its signals one sample at a time, joints other than hinges) or where the run goes bad
     (the caller then runs it the ordinary way, which says why)."""
@@ -309,6 +328,13 @@ def run_from_states(scene, drive, wave, duration: float, initial_curvature: floa
         return None
     rows = np.concatenate([state0[None], states[0]])
     steps = np.arange(n + 1)
+    if tip_only:
+        kin = chain_kinematics(m, rows[:, 1:1 + m.nq], [part.clamp_id, part.tip_body_id], part.tip_body_id)
+        if kin is None:
+            return None
+        pos, rot = kin
+        site = pos[:, 1] + rot @ m.site_pos[part.tip_site_id]
+        return TipPath(steps * dt, part.clamp_frame(site - pos[:, 0]))
     drive.part = part
     try:
         sig = drive.native_signal_history(steps, rows, part, native.handles)
@@ -350,10 +376,12 @@ def _integrator(scene, h: float) -> str:
     return "implicitfast" if 2 * h <= scene.choice.rayleigh_beta else "discrete"
 
 
-def _choose(scene, em: ErrorModel, target: float, duration: float, grid: float, h_cap: float) -> Model:
-    """The cheapest model with predicted error <= target / SAFETY, h on the grid / 2 (the
-    2 h companion's step divides it), a run's overhead in its cost."""
-    return choose_model(scene, em, target, duration, grid, h_cap, widest=2, cost=_cost, integrator=_integrator)
+def _choose(scene, em: ErrorModel, target: float, duration: float, grid: float, h_cap: float,
+            widest: int = 2) -> Model:
+    """The cheapest model with predicted error <= target / SAFETY, h on the grid / ``widest``
+    (the widest companion's step divides it: 2 h, or 4 h where it extrapolates), a run's
+    overhead in its cost."""
+    return choose_model(scene, em, target, duration, grid, h_cap, widest=widest, cost=_cost, integrator=_integrator)
 
 
 class _EveryOther:
@@ -368,11 +396,34 @@ class _EveryOther:
 SAMPLING_RICHARDSON = 3.0
 
 
+def _extrapolate(q: float, q_2h: float, q_4h: float) -> Optional[tuple]:
+    """(value, step error) of a metric from its values at h, 2 h and 4 h by Richardson's
+    extrapolation at order 1 (backward Euler, the drive held over the step): d1 = q - q_2h,
+    d2 = q_2h - q_4h; where the observed order log2(d2 / d1) is within
+    EXTRAPOLATION_ORDERS the value is q + d1 (its first-order error removed) and its error
+    |(q + d1) - (q_2h + d2)| / 3 (order 2), at least EXTRAPOLATION_FLOOR x |d1|; None
+    outside the window (not in the asymptotic range: the run's own value stands)."""
+    d1, d2 = q - q_2h, q_2h - q_4h
+    if d1 == 0 or not d2 / d1 > 0:
+        return None
+    if not EXTRAPOLATION_ORDERS[0] <= math.log2(d2 / d1) <= EXTRAPOLATION_ORDERS[1]:
+        return None
+    return q + d1, max(abs(2 * d1 - d2) / 3.0, EXTRAPOLATION_FLOOR * abs(d1))
+
+
+def _observed_order(q: float, q_2h: float, q_4h: float) -> Optional[float]:
+    """log2(d2 / d1) of :func:`_extrapolate` (None where d1 is 0 or the signs differ)."""
+    d1, d2 = q - q_2h, q_2h - q_4h
+    return math.log2(d2 / d1) if d1 != 0 and d2 / d1 > 0 else None
+
+
 def _evaluate(metrics, runs, period, duration, step) -> Dict[str, dict]:
-    """Each metric's value on the chosen run and its (step, segments, sampling) errors
-    relative to its scale, from the runs (F, F_2h, S_2h) and the segment counts (N, n);
-    the sampling's only where F was sampled coarser than its ``step``."""
-    (f, mid, fewer), (n_f, n_s) = runs
+    """Each metric's value and its (step, segments, sampling) errors relative to its scale,
+    from the runs (F, F_2h, S_2h, F_4h or None) and the segment counts (N, n): the value
+    F's own, or extrapolated where F_4h was run and the step's order is observed to be 1
+    (:func:`_extrapolate`; ``run_value`` then holds F's own); the sampling's error only
+    where F was sampled coarser than its ``step``."""
+    (f, mid, fewer, quad), (n_f, n_s) = runs
     coarse = len(f.time) > 1 and f.time[1] - f.time[0] > 1.5 * step      # sampled coarser than its step
     sparse = _EveryOther(f)
     out = {}
@@ -382,14 +433,31 @@ def _evaluate(metrics, runs, period, duration, step) -> Dict[str, dict]:
         e_h = _relative(abs(q[0] - q[1]), scale) / STEP_RICHARDSON
         e_s = _relative(abs(q[1] - q[2]), scale) / ((n_f / n_s) ** 2 - 1)
         e_t = _relative(abs(q[0] - q[3]), scale) / SAMPLING_RICHARDSON if coarse else 0.0
+        q4 = None if quad is None or coarse else metric_quantity(name, quad, period)
+        x = None if q4 is None else _extrapolate(q[0], q[1], q4)
+        value = q[0]
+        if x is not None:
+            value, e_h = x[0], _relative(x[1], scale)
         e = math.sqrt(e_h ** 2 + e_s ** 2 + e_t ** 2)
-        row = {"value": q[0], "estimated_error": e, "step_error": e_h, "segments_error": e_s,
-               "sampling_error": e_t, "scale": METRIC_SCALES[name]}
+        row = {"value": value, "estimated_error": e, "step_error": e_h, "segments_error": e_s,
+               "sampling_error": e_t, "scale": METRIC_SCALES[name], "extrapolated": x is not None}
+        if q4 is not None:
+            row["observed_step_order"] = _observed_order(q[0], q[1], q4)
+        if x is not None:
+            row["run_value"] = q[0]
         if name == "returns":
-            margin = _relative(q[0], scale)
+            margin = _relative(value, scale)
             row.update(margin=margin, decided=abs(margin) > e)
         out[name] = row
     return out
+
+
+def reported_value(result, name: str, period: Optional[float]) -> float:
+    """The value of metric ``name`` a run at a target on metrics reports (its margin for
+    ``returns``): ``meta['accuracy']['metrics'][name]['value']`` where the target was on
+    it (extrapolated where the report says so), else read from the run's samples."""
+    found = result.meta.get("accuracy", {}).get("metrics", {}).get(name)
+    return float(found["value"]) if found and "value" in found else metric_quantity(name, result, period)
 
 
 def _needs(metrics: Dict[str, dict], target: float) -> float:
@@ -408,8 +476,9 @@ def run_metrics_at_accuracy(scene, run, *, metrics: Sequence[str], accuracy: flo
     """Choose, run and check a model of ``scene`` whose ``metrics`` (names of
     :data:`METRIC_SCALES`) are within ``accuracy`` of their scales. ``run(scene, interval)``
     runs one model sampled every ``interval`` s (None: every step) and returns a
-    RolloutResult; ``every_step(scene)``, where given, runs one sampled every step the faster
-    way (:func:`run_from_states`; None where that does not apply: ``run`` then runs it);
+    RolloutResult; ``every_step(scene, tip_only)``, where given, runs one sampled every step
+    the faster way (:func:`run_from_states`; the companions ``tip_only``; None where that does
+    not apply: ``run`` then runs it);
     ``drive`` (the question's drive) bounds the relaxed step. ``error_model``:
     (a, b) of a similar question (a sweep's earlier point) choosing the first model. Returns
     (result, scene of the chosen model, report), the report also in
@@ -431,37 +500,58 @@ def run_metrics_at_accuracy(scene, run, *, metrics: Sequence[str], accuracy: flo
     own_grid = relaxed is not None and sample_interval is None
     grid = period / SAMPLES_PER_PERIOD if own_grid else (sample_interval or duration)
     h_cap = min(h_cap, grid)
+    widest = 4 if relaxed is not None and own_grid else 2      # the widest companion's step factor
     log: List[dict] = []
     done: Dict[tuple, tuple] = {}        # (model, interval) -> (scene, result): a refinement's companions reuse them
 
-    def one(model: Model, role: str, interval=None):
-        if (model, interval) in done:
+    def one(model: Model, role: str, interval=None, tip_only: bool = False):
+        """The run of ``model`` sampled every ``interval`` s (a companion's: ``tip_only``,
+        where it is read from its states: the tip alone, all its metrics read)."""
+        if (model, interval) in done and (tip_only or not isinstance(done[model, interval][1], TipPath)):
             log.append({"role": role + " (reused)", **asdict(model), "wall_time_s": 0.0})
             return done[model, interval]
         s = scene.variant(model.segments, model.timestep, model.integrator)
         t = _time.perf_counter()
-        out = every_step(s) if every_step is not None and interval == model.timestep else None
+        out = every_step(s, tip_only) if every_step is not None and interval == model.timestep else None
         if out is None:
             out = run(s, interval)
         log.append({"role": role, **asdict(model), "wall_time_s": _time.perf_counter() - t})
         done[model, interval] = s, out
         return s, out
 
+    def extrapolating(model: Model) -> bool:
+        """Whether an attempt at ``model`` adds the run at 4 h (:func:`_extrapolate`): relaxed
+        steps under 'discrete', each run sampled every step, 4 h dividing the drive's grid."""
+        k = grid / (4 * model.timestep)
+        return relaxed is not None and own_grid and model.integrator == "discrete" and k >= 1 - 1e-9 and \
+            abs(k - round(k)) <= 1e-9 * k
+
     def runs_of(model: Model) -> list:
-        """The runs an attempt at ``model`` needs: it and its two companions."""
+        """The runs an attempt at ``model`` needs: it and its companions (2 h, fewer segments
+        at 2 h, and 4 h where it extrapolates)."""
         h2 = 2 * model.timestep
-        return [(model, sample_interval or model.timestep),
-                (Model(model.segments, h2, model.integrator), sample_interval or h2),
-                (Model(fewer_segments(model.segments), h2, model.integrator), sample_interval or h2)]
+        out = [(model, sample_interval or model.timestep),
+               (Model(model.segments, h2, model.integrator), sample_interval or h2),
+               (Model(fewer_segments(model.segments), h2, model.integrator), sample_interval or h2)]
+        if extrapolating(model):
+            out.append((Model(model.segments, 2 * h2, model.integrator), 2 * h2))
+        return out
 
     def new_cost(model: Model) -> float:
         """The cost of an attempt at ``model``, less the runs already done."""
         return sum(_cost(m, duration) for m, i in runs_of(model) if (m, i) not in done)
 
-    def refine(em: ErrorModel, need: float, last: Model) -> Model:
+    def refine(em: ErrorModel, need: float, last: Model, pre_asymptotic: bool) -> Model:
         """The cheapest next model by the error model: :func:`_choose`'s, or ``last``'s
-        segments at an integer fraction of its step (its runs then serve as companions)."""
-        best = _choose(scene, em, need, duration, grid, h_cap)
+        segments at an integer fraction of its step (its runs then serve as companions);
+        where ``last``'s step was outside the asymptotic range (``pre_asymptotic``: a
+        metric's observed order outside EXTRAPOLATION_ORDERS), half its step (the runs at h
+        and 2 h then serve as companions) and the segments the error model's spatial part
+        needs."""
+        if pre_asymptotic:
+            return _choose(scene, ErrorModel(em.spatial, 0.0), need, duration, grid,
+                           min(h_cap, last.timestep / 2), widest)
+        best = _choose(scene, em, need, duration, grid, h_cap, widest)
         for k in (2, 3, 4, 6, 8):
             m = Model(last.segments, last.timestep / k, last.integrator)
             if em.predict(m) <= need / SAFETY and _integrator(scene, m.timestep) == last.integrator and \
@@ -470,19 +560,20 @@ def run_metrics_at_accuracy(scene, run, *, metrics: Sequence[str], accuracy: flo
         return best
 
     def attempt(model: Model, role: str):
-        (m_f, i_f), (m_mid, i_mid), (m_s, i_s) = runs_of(model)
+        (m_f, i_f), (m_mid, i_mid), (m_s, i_s), *rest = runs_of(model)
         chosen, f = one(m_f, role, i_f)
-        _, mid = one(m_mid, "companion", i_mid)
-        _, fewer = one(m_s, "spatial companion", i_s)
-        return chosen, f, _evaluate(names, ((f, mid, fewer), (model.segments, m_s.segments)), period, duration,
-                                    model.timestep)
+        _, mid = one(m_mid, "companion", i_mid, tip_only=True)
+        _, fewer = one(m_s, "spatial companion", i_s, tip_only=True)
+        quad = one(rest[0][0], "extrapolation companion", rest[0][1], tip_only=True)[1] if rest else None
+        return chosen, f, _evaluate(names, ((f, mid, fewer, quad), (model.segments, m_s.segments)), period,
+                                    duration, model.timestep)
 
     if given is not None:       # not below START_SEGMENTS: a family's first point (its lightest load, on the
         # map) predicts too few for the rest (from 4 segments 13 of the map's 23 other points were refined)
-        model = _choose(scene, given, target, duration, grid, h_cap)
+        model = _choose(scene, given, target, duration, grid, h_cap, widest)
         model = Model(max(model.segments, START_SEGMENTS), model.timestep, model.integrator)
     else:
-        h0 = _on_grid(h_cap, grid / 2)
+        h0 = _on_grid(h_cap, grid / widest)
         model = Model(START_SEGMENTS, h0, _integrator(scene, h0))
     chosen, result, found = attempt(model, "chosen")
     em = given or ErrorModel(0.0, 0.0)
@@ -491,7 +582,8 @@ def run_metrics_at_accuracy(scene, run, *, metrics: Sequence[str], accuracy: flo
     while need > 0 and refinements < MAX_REFINEMENTS:
         em = ErrorModel(max(max(m["segments_error"] for m in found.values()) * model.segments ** 2, 1e-12),
                         max(max(m["step_error"] for m in found.values()) / model.timestep, 1e-12))
-        nxt = refine(em, need, model)
+        nxt = refine(em, need, model, any(not m["extrapolated"] for m in found.values()
+                                          if "observed_step_order" in m))
         if duration / nxt.timestep > MAX_MODEL_STEPS or \
                 (nxt.segments <= model.segments and nxt.timestep >= model.timestep):
             break

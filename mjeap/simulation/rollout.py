@@ -157,8 +157,8 @@ def _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, 
         from .metric_accuracy import run_from_states, run_metrics_at_accuracy
         every_step = None       # each run sampled every step, read from its states where that applies
         if controller is None and engine in ("auto", "native") and stop_when_periodic is None and max_steps is None:
-            def every_step(s):
-                return run_from_states(s, type(drv)(s, **params), wave, duration, initial_curvature)
+            def every_step(s, tip_only=False):
+                return run_from_states(s, type(drv)(s, **params), wave, duration, initial_curvature, tip_only)
         result, chosen, _ = run_metrics_at_accuracy(scene, run, metrics=metrics, accuracy=target, duration=duration,
                                                     drive=drv, wave=wave, sample_interval=sample_interval,
                                                     error_model=error_model, every_step=every_step)

@@ -43,6 +43,7 @@ Damping and timestep are derived from the compiled model, never tuned by hand:
 from __future__ import annotations
 
 import math
+import threading
 import warnings
 from collections import OrderedDict
 from dataclasses import dataclass
@@ -153,11 +154,28 @@ ANALYSIS_CACHE_SIZE = 256
 ANALYSIS_CACHE_BYTES = 64 * 2**20
 
 
+#: an accuracy target's models (:meth:`Scene.variant`), per thread (a model's data is its
+#: runs' state), by everything they are built from: a map's points of one payload at every
+#: amplitude, and a refinement's companions, run the same models (each run resets its state;
+#: the tip loads are set again on every use; a variant whose hinges were set by hand is not
+#: reused). Oldest dropped past VARIANT_CACHE_SIZE
+_VARIANTS = threading.local()
+VARIANT_CACHE_SIZE = 32
+
+
+def _variants() -> "OrderedDict[tuple, Scene]":
+    cache = getattr(_VARIANTS, "cache", None)
+    if cache is None:
+        cache = _VARIANTS.cache = OrderedDict()
+    return cache
+
+
 def clear_build_caches() -> None:
-    """Forget the analyses, layouts and native models' stability that scenes share (a
-    benchmark's cold start)."""
+    """Forget the analyses, layouts, variants and native models' stability that scenes
+    share (a benchmark's cold start)."""
     from .native_model import clear_stable
     _ANALYSES.clear()
+    _variants().clear()
     clear_layouts()
     clear_stable()
 
@@ -403,10 +421,20 @@ class Scene:
         (:meth:`set_tip_force`, :meth:`set_tip_moment`) act on the variant too; hinge
         parameters set by hand belong to this model's hinges and are refused."""
         self.part.check_derivable()
-        s = Scene.__new__(Scene)
-        s.chosen_model = True
-        Scene.__init__(s, **{**self._arguments, "segments": segments, "timestep": timestep,
-                             "integrator": integrator})
+        args = {**self._arguments, "segments": segments, "timestep": timestep, "integrator": integrator}
+        key = tuple((k, id(v) if k == "actuator" else np.asarray(v).tobytes() if k == "orientation" and
+                     not isinstance(v, str) else v) for k, v in sorted(args.items()))
+        cache = _variants()
+        s = cache.get(key)
+        if s is None or s.actuator is not self.actuator or s.part.revision:
+            s = Scene.__new__(Scene)
+            s.chosen_model = True
+            Scene.__init__(s, **args)
+            cache[key] = s
+            while len(cache) > VARIANT_CACHE_SIZE:
+                cache.popitem(last=False)
+        else:
+            cache.move_to_end(key)
         self.part.carry_loads(s.part)
         return s
 

@@ -12,7 +12,7 @@ from typing import Callable, Dict, Optional, Sequence
 import numpy as np
 
 from ..errors import DivergenceError, ParameterError, check_registration
-from ..simulation.metric_accuracy import peak_to_peak, returns_margin
+from ..simulation.metric_accuracy import reported_value
 from .design import PARAMETERS
 
 
@@ -23,14 +23,16 @@ def _period(point) -> Optional[float]:
 
 def metric_peak_to_peak(r, point, scene) -> float:
     """Peak-to-peak tip curvature (1/m) over the last drive period (the second half of the
-    run without a frequency)."""
-    return peak_to_peak(r.time, r.tip_curvature, _period(point))
+    run without a frequency); at a target on it, the value the accuracy report gives
+    (:func:`mjeap.simulation.metric_accuracy.reported_value`)."""
+    return reported_value(r, "peak_to_peak", _period(point))
 
 
 def metric_returns(r, point, scene) -> bool:
     """Seed 000's stability criterion: the tip curvature still changes sign in the last
-    drive period (the actuator follows the drive instead of staying collapsed)."""
-    return returns_margin(r.time, r.tip_curvature, _period(point)) > 0
+    drive period (the actuator follows the drive instead of staying collapsed); at a target on
+    it, decided on the margin the accuracy report gives."""
+    return reported_value(r, "returns", _period(point)) > 0
 
 
 def metric_settling_time(r, point, scene) -> float:

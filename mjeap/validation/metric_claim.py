@@ -31,7 +31,7 @@ import numpy as np
 
 from ..drives import make_drive
 from .accuracy_claim import Case as TrajectoryCase
-from ..simulation.metric_accuracy import metric_quantity, metric_scale
+from ..simulation.metric_accuracy import metric_quantity, metric_scale, reported_value
 from ..simulation.rollout import rollout
 from ..simulation.scene import Scene
 
@@ -193,7 +193,7 @@ def check_case(golden: dict) -> dict:
     for m in case.metrics:
         ref = golden["metrics"][m]
         est = a["metrics"][m]
-        value = metric_quantity(m, r, period)
+        value = reported_value(r, m, period)
         row = {"true_error": abs(value - ref["value"]) / ref["scale"] if ref["scale"] > 0 else 0.0,
                "estimated_error": est["estimated_error"], "reference_uncertainty": ref["uncertainty"]}
         if m == "returns":
