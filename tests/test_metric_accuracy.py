@@ -61,6 +61,86 @@ def test_map_point_at_a_target_on_its_metrics():
     kr = r.tip_curvature[r.time >= r.time[-1] - 10.0]
     swing = k.max() - k.min()
     assert abs((kr.max() - kr.min()) - (k[last].max() - k[last].min())) / swing < 1e-2
+    # the answer reported: extrapolated from the runs at h, 2 h, 4 h (the trajectory is the
+    # run at h); closer to the default model's than the run's own value
+    pp = a["metrics"]["peak_to_peak"]
+    assert pp["extrapolated"] and 0.7 <= pp["observed_step_order"] <= 1.4
+    assert pp["run_value"] == pytest.approx(kr.max() - kr.min(), rel=1e-12)
+    ref_pp = k[last].max() - k[last].min()
+    assert abs(pp["value"] - ref_pp) < abs(pp["run_value"] - ref_pp)
+
+
+def test_extrapolation_only_in_the_asymptotic_range():
+    """Richardson at order 1 from three steps: q + (q - q_2h) where the observed order
+    log2(d2 / d1) is within 0.7..1.4, its error |2 d1 - d2| / 3 but not below a tenth of the
+    correction; outside the window (or d1 = 0, or the differences of opposite sign) none."""
+    from mjeap.simulation.metric_accuracy import _extrapolate
+    # an exact first-order sequence q(h) = 1 + c h: the limit recovered, error at its floor
+    c, h = 0.3, 0.025
+    value, err = _extrapolate(1 + c * h, 1 + 2 * c * h, 1 + 4 * c * h)
+    assert value == pytest.approx(1.0, abs=1e-15) and err == pytest.approx(0.1 * c * h)
+    # q(h) = 1 + c h + e h^2 (observed order log2 2.4 = 1.26): the value 1 - 2 e h^2, and the
+    # estimate |2 d1 - d2| / 3 = 2 e h^2 exactly (above the floor, 0.1 |d1|)
+    e = 1.0
+    value, err = _extrapolate(*[1 + c * x + e * x * x for x in (h, 2 * h, 4 * h)])
+    assert value == pytest.approx(1 - 2 * e * h * h, abs=1e-15) and err == pytest.approx(2 * e * h * h)
+    assert _extrapolate(1 + c * h ** 2, 1 + c * 4 * h ** 2, 1 + c * 16 * h ** 2) is None     # order 2: not in the window
+    assert _extrapolate(1.0, 1.0, 1.2) is None
+    assert _extrapolate(1.0, 1.1, 1.0) is None
+
+
+def test_a_map_row_reports_the_extrapolated_answer(tmp_path):
+    """A sweep at a target on its metrics writes the values the accuracy report gives (the
+    extrapolated peak-to-peak and the returns decided on the extrapolated margin), not those
+    read from the recorded run."""
+    from mjeap.analysis.stability import MAP_BASE
+    from mjeap.sweep.runner import evaluate
+    point = {"payload_mass": 70e-6, "amplitude": 1.5}
+    row = evaluate(point, ("returns", "peak_to_peak"), {**MAP_BASE, "accuracy": 1e-2})
+    from mjeap.model.discretize import Payload
+    s = Scene("pedot-micro", orientation="up", payload=Payload(70e-6, 6.27e-3))       # as the sweep builds it
+    r = rollout(s, "square:1.5V@0.1Hz,offset=0.0V", 30.0, accuracy=1e-2, metrics=("returns", "peak_to_peak"),
+                progress=False)
+    a = r.meta["accuracy"]["metrics"]
+    assert row["peak_to_peak"] == a["peak_to_peak"]["value"] != a["peak_to_peak"]["run_value"]
+    assert row["returns"] is (a["returns"]["value"] > 0)
+
+
+def test_companions_read_at_the_tip_equal_the_full_read():
+    """A companion's run read at the tip alone (TipPath) gives the full read's time, tip
+    position and tip curvature to round-off."""
+    s = Scene("pedot-micro", orientation="up", payload="70mg@6.27mm").variant(8, 0.05, "discrete")
+    wave = to_waveform("square:1V@0.1Hz", 20.0)
+    full = run_from_states(s, make_drive(None, s), wave, 20.0)
+    tip = run_from_states(s, make_drive(None, s), wave, 20.0, tip_only=True)
+    for k in ("time", "tip_position", "tip_curvature"):
+        a, b = getattr(tip, k), getattr(full, k)
+        assert a.shape == b.shape and np.max(np.abs(a - b)) <= 1e-12 * np.max(np.abs(b)), k
+
+
+def test_variants_are_reused_and_stay_their_own():
+    """An accuracy target's variant of the same scene arguments is the same model (a map's
+    amplitudes at one payload); the parent's tip loads are set on it at every use; a variant
+    whose hinges were set by hand is built again; the cache is per thread."""
+    import threading
+    from mjeap.simulation.scene import clear_build_caches
+    clear_build_caches()
+    a = Scene("pedot-micro", **MAP_SCENE)
+    b = Scene("pedot-micro", **MAP_SCENE)
+    v = a.variant(8, 0.025, "discrete")
+    assert b.variant(8, 0.025, "discrete") is v
+    assert a.variant(8, 0.05, "discrete") is not v and a.variant(9, 0.025, "discrete") is not v
+    assert Scene("pedot-micro", orientation="up", payload="71mg@6.27mm").variant(8, 0.025, "discrete") is not v
+    b.set_tip_force([0.0, 1e-6, 0.0])
+    assert b.variant(8, 0.025, "discrete").has_tip_load()
+    assert not a.variant(8, 0.025, "discrete").has_tip_load()
+    v.set_hinge_parameters(stiffness=1e-6)
+    assert a.variant(8, 0.025, "discrete") is not v
+    other = []
+    t = threading.Thread(target=lambda: other.append(a.variant(8, 0.025, "discrete")))
+    t.start()
+    t.join()
+    assert other[0] is not a.variant(8, 0.025, "discrete")
 
 
 def _claim(goldens):

@@ -78,20 +78,23 @@ def test_bad_sweep_input():
 def test_at_a_target_a_family_shares_its_first_points_error_model(tmp_path, monkeypatch):
     """Points differing only in load sizes (amplitude here) start from the first one's error
     model: the others are handed the (a, b) the first ran with (the row says 'shared error
-    model'; a target on the metric peak_to_peak chooses the first point's model with no prior,
-    mjeap.simulation.metric_accuracy, and so does every point without sharing); another
-    actuator is another family. Each point's estimated error is measured
-    on it and meets the target, and its peak-to-peak agrees with pilots per point within
-    what the two targets allow."""
+    model'; the first ran its pilots, and so does every point without sharing); another
+    actuator is another family. A target on the trajectory (peak_power is no metric a target
+    can be put on, mjeap.simulation.metric_accuracy): a target on the metrics alone forms no
+    family (no pilots to share). Each point's estimated error is measured on it and
+    meets the target, and its peak-to-peak agrees with pilots per point within what the two
+    targets allow."""
     import mjeap.sweep.runner as sw
     from mjeap.sweep.runner import _family
-    base = {"actuator": "pedot-micro", "orientation": "horizontal", "waveform": "sine", "frequency": 5.0,
+    base = {"actuator": "pedot-micro", "orientation": "horizontal", "waveform": "sine", "frequency": 10.0,
             "duration": 0.2, "accuracy": 1e-3}
     pts = [{"amplitude": a} for a in (0.5, 1.0, 1.5)]
-    jobs = [(p, ("peak_to_peak",), base, None) for p in pts]
+    metrics = ("peak_to_peak", "peak_power", "estimated_error")
+    jobs = [(p, metrics, base, None) for p in pts]
     assert len({_family(j) for j in jobs}) == 1
-    assert _family(({"actuator": "ppy-mutlu", "amplitude": 1.0}, (), base, None)) != _family(jobs[0])
-    assert _family(({"amplitude": 1.0}, (), {**base, "accuracy": None}, None)) is None
+    assert _family(({"actuator": "ppy-mutlu", "amplitude": 1.0}, metrics, base, None)) != _family(jobs[0])
+    assert _family(({"amplitude": 1.0}, metrics, {**base, "accuracy": None}, None)) is None
+    assert _family(({"amplitude": 1.0}, ("peak_to_peak", "first_frequency", "estimated_error"), base, None)) is None
     calls, evaluate = [], sw.evaluate
 
     def spy(point, metrics, base, rrd_dir, error_model=None):
@@ -102,16 +105,15 @@ def test_at_a_target_a_family_shares_its_first_points_error_model(tmp_path, monk
     rows = {}
     for share in (True, False):
         path = tmp_path / f"share{share}.csv"
-        run_sweep(pts, path, metrics=("peak_to_peak", "estimated_error"), base=base, executor="serial",
-                  share_error_models=share)
+        run_sweep(pts, path, metrics=metrics, base=base, executor="serial", share_error_models=share)
         rows[share] = read_results(path)
     lead = calls[0]
     assert lead[1] is None and lead[2] is not None
     assert [c[1] for c in calls[1:3]] == [lead[2], lead[2]]          # the others got the lead's (a, b)
     assert all(c[1] is None for c in calls[3:])                         # pilots per point
     shared = [r["estimated_error"] for r in rows[True]]
-    assert sum("shared error model" in e for e in shared) == 2 and "no prior" in shared[0]
-    assert all("no prior" in r["estimated_error"] for r in rows[False])
+    assert sum("shared error model" in e for e in shared) == 2 and "pilots" in shared[0]
+    assert all("pilots" in r["estimated_error"] for r in rows[False])
     for a, b in zip(rows[True], rows[False]):
         assert float(a["estimated_error"].split()[0]) <= 1e-3 and float(b["estimated_error"].split()[0]) <= 1e-3
         # each run's curvature within 1e-3 of the swing: each peak-to-peak within 2 x that, the two within 4 x

@@ -154,28 +154,49 @@ ANALYSIS_CACHE_SIZE = 256
 ANALYSIS_CACHE_BYTES = 64 * 2**20
 
 
-#: an accuracy target's models (:meth:`Scene.variant`), per thread (a model's data is its
-#: runs' state), by everything they are built from: a map's points of one payload at every
-#: amplitude, and a refinement's companions, run the same models (each run resets its state;
-#: the tip loads are set again on every use; a variant whose hinges were set by hand is not
-#: reused). Oldest dropped past VARIANT_CACHE_SIZE
-_VARIANTS = threading.local()
-VARIANT_CACHE_SIZE = 32
+#: scenes built for reuse, per thread (a scene's data is its runs' state), by everything they
+#: are built from: an accuracy target's models (:meth:`Scene.variant`: a map's points of one
+#: payload at every amplitude, a refinement's companions) and a sweep's point scenes
+#: (:meth:`Scene.shared`). Each run resets the state; a scene whose hinges were set by hand,
+#: or a point scene left with a tip load, is built again. Oldest dropped past SHARED_SCENES
+_SHARED = threading.local()
+SHARED_SCENES = 64
 
 
-def _variants() -> "OrderedDict[tuple, Scene]":
-    cache = getattr(_VARIANTS, "cache", None)
+def _shared_scenes() -> "OrderedDict[tuple, Scene]":
+    cache = getattr(_SHARED, "cache", None)
     if cache is None:
-        cache = _VARIANTS.cache = OrderedDict()
+        cache = _SHARED.cache = OrderedDict()
     return cache
 
 
+def _shared(args: dict, chosen_model: bool) -> "Scene":
+    """The scene of Scene's keywords ``args`` (the actuator an object) from this thread's
+    cache, built and kept there where missing or no longer as built."""
+    key = (chosen_model,) + tuple((k, id(v) if k == "actuator" else np.asarray(v).tobytes()
+                                   if k == "orientation" and not isinstance(v, str) else v)
+                                  for k, v in sorted(args.items()))
+    cache = _shared_scenes()
+    s = cache.get(key)
+    if s is None or s.actuator is not args["actuator"] or s.part.revision or \
+            (not chosen_model and s.part.has_tip_load()):
+        s = Scene.__new__(Scene)
+        s.chosen_model = chosen_model
+        Scene.__init__(s, **args)
+        cache[key] = s
+        while len(cache) > SHARED_SCENES:
+            cache.popitem(last=False)
+    else:
+        cache.move_to_end(key)
+    return s
+
+
 def clear_build_caches() -> None:
-    """Forget the analyses, layouts, variants and native models' stability that scenes
+    """Forget the analyses, layouts, shared scenes and native models' stability that scenes
     share (a benchmark's cold start)."""
     from .native_model import clear_stable
     _ANALYSES.clear()
-    _variants().clear()
+    _shared_scenes().clear()
     clear_layouts()
     clear_stable()
 
@@ -412,6 +433,14 @@ class Scene:
         payload, units, damping_ratio, gravity, max_bend, accuracy): a copy."""
         return dict(self._arguments)
 
+    @classmethod
+    def shared(cls, actuator: Union[str, Actuator], **kwargs) -> "Scene":
+        """``Scene(actuator, **kwargs)`` from this thread's cache of built scenes (built and
+        kept there where missing): a sweep's points of one scene, at every amplitude, share
+        it (each run resets its state; one whose hinges were set by hand or that carries a
+        tip load is built again)."""
+        return _shared({"actuator": get_actuator(actuator), **kwargs}, chosen_model=False)
+
     def variant(self, segments: int, timestep: float, integrator: str) -> "Scene":
         """This scene (actuator, orientation, payload, units, damping, gravity) as a model
         of ``segments`` hinges stepped at ``timestep`` (s) under ``integrator``, as chosen for
@@ -419,22 +448,11 @@ class Scene:
         timestep; above beta under 'discrete' the step's own damping h K exceeds the beam's,
         an error the target's estimate accounts for. The tip loads set on this scene
         (:meth:`set_tip_force`, :meth:`set_tip_moment`) act on the variant too; hinge
-        parameters set by hand belong to this model's hinges and are refused."""
+        parameters set by hand belong to this model's hinges and are refused. Built once per
+        thread for the same arguments and reused (:meth:`shared`'s cache)."""
         self.part.check_derivable()
-        args = {**self._arguments, "segments": segments, "timestep": timestep, "integrator": integrator}
-        key = tuple((k, id(v) if k == "actuator" else np.asarray(v).tobytes() if k == "orientation" and
-                     not isinstance(v, str) else v) for k, v in sorted(args.items()))
-        cache = _variants()
-        s = cache.get(key)
-        if s is None or s.actuator is not self.actuator or s.part.revision:
-            s = Scene.__new__(Scene)
-            s.chosen_model = True
-            Scene.__init__(s, **args)
-            cache[key] = s
-            while len(cache) > VARIANT_CACHE_SIZE:
-                cache.popitem(last=False)
-        else:
-            cache.move_to_end(key)
+        s = _shared({**self._arguments, "segments": segments, "timestep": timestep, "integrator": integrator},
+                    chosen_model=True)
         self.part.carry_loads(s.part)
         return s
 

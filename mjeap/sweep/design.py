@@ -219,8 +219,23 @@ def _check_fixed(points: Sequence[dict], base: dict) -> None:
                              f"{e.why}; {fixed}" if e.why else fixed) from None
 
 
+#: the parameters a point's scene is built from (with the design parameters, ``actuator.*``);
+#: the others are its drive's and its run's
+SCENE_PARAMETERS = ("actuator", "representation", "segments", "orientation", "payload_mass", "payload_position",
+                    "damping_ratio", "accuracy")
+
+
+def scene_key(p: dict) -> str:
+    """What a point's scene is built from (its full parameters ``p``), as text: points with
+    the same key share a scene (:func:`_scene`)."""
+    from ..design import is_design_parameter
+    return json.dumps({k: v for k, v in p.items() if k in SCENE_PARAMETERS or is_design_parameter(k)},
+                      sort_keys=True, default=str)
+
+
 def _scene(p: dict):
-    """The Scene of a point's full parameters (``base`` and the defaults filled in)."""
+    """The Scene of a point's full parameters (``base`` and the defaults filled in), shared
+    with the earlier points of the same scene in this thread (:meth:`Scene.shared`)."""
     from ..model.discretize import Payload
     from ..simulation.scene import Scene
     payload = None
@@ -233,9 +248,9 @@ def _scene(p: dict):
     act = p["actuator"]
     if any(is_design_parameter(k) for k in p):
         act = design_actuator(act, p)
-    return Scene(act, representation=p["representation"], segments=int(p["segments"]),
-                 orientation=p["orientation"], payload=payload, damping_ratio=p["damping_ratio"],
-                 accuracy=None if p["accuracy"] in (None, "") else float(p["accuracy"]))
+    return Scene.shared(act, representation=p["representation"], segments=int(p["segments"]),
+                        orientation=p["orientation"], payload=payload, damping_ratio=p["damping_ratio"],
+                        accuracy=None if p["accuracy"] in (None, "") else float(p["accuracy"]))
 
 
 def _wave_text(p: dict) -> str:

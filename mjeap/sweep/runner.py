@@ -22,6 +22,9 @@ import sys
 import time
 import traceback
 import warnings
+from collections import OrderedDict, deque
+from concurrent.futures import FIRST_COMPLETED, wait
+from concurrent.futures.process import BrokenProcessPool
 from dataclasses import dataclass
 from pathlib import Path
 from typing import List, Optional, Sequence
@@ -224,9 +227,13 @@ LOAD_SIZE = ("payload_mass", "amplitude", "offset", "initial_curvature")
 
 
 def _family(job) -> Optional[str]:
-    """The accuracy family of a job: its parameters less LOAD_SIZE, or None without a target."""
+    """The accuracy family of a job: its parameters less LOAD_SIZE; None without a target,
+    or with one on its metrics (:func:`targeted_metrics`: no pilots to share; each point
+    starts from the same first model, and on the stability map the family's error model
+    chose the same models as the points' own, while the family phase before the rest held
+    2 workers back: 21.7-22.5 against 23.7 points/s)."""
     p = {**PARAMETERS, **(job[2] or {}), **job[0]}
-    if p["accuracy"] in (None, ""):
+    if p["accuracy"] in (None, "") or targeted_metrics([m for m in job[1] if m not in _metrics.STATIC_METRICS]):
         return None
     return json.dumps({k: v for k, v in p.items() if k not in LOAD_SIZE}, sort_keys=True, default=float)
 
@@ -252,16 +259,22 @@ def _with_shared_error_models(executor: str, workers: int, scheduler: Optional[s
         yield from _submit_all(executor, workers, scheduler, jobs)
         return
     models = {}
-    for row in _submit_all(executor, workers, scheduler, first):
-        if row["point_id"] in lead_family:
-            models[lead_family[row["point_id"]]] = row.get("_error_model")
-        yield row
-    yield from _submit_all(executor, workers, scheduler,
-                           [tuple(job[:4]) + (models.get(key),) for key, job in rest])
+    pools = _Pools(workers) if executor == "processes" else None     # one pool for both phases
+    try:
+        for row in _submit_all(executor, workers, scheduler, first, pools):
+            if row["point_id"] in lead_family:
+                models[lead_family[row["point_id"]]] = row.get("_error_model")
+            yield row
+        yield from _submit_all(executor, workers, scheduler,
+                               [tuple(job[:4]) + (models.get(key),) for key, job in rest], pools)
+    finally:
+        if pools is not None:
+            pools.close()
 
 
-def _submit_all(executor: str, workers: int, scheduler: Optional[str], jobs):
-    """Yield finished rows as they complete."""
+def _submit_all(executor: str, workers: int, scheduler: Optional[str], jobs, pools: "Optional[_Pools]" = None):
+    """Yield finished rows as they complete (``pools``: the worker processes to run them in,
+    kept by the caller)."""
     if executor == "serial":
         from threadpoolctl import threadpool_limits
         with threadpool_limits(1):
@@ -269,7 +282,7 @@ def _submit_all(executor: str, workers: int, scheduler: Optional[str], jobs):
                 yield evaluate(*args)
         return
     if executor == "processes":
-        yield from _run_processes(list(jobs), workers)
+        yield from _run_processes(list(jobs), workers, pools)
         return
     if executor == "dask":  # run_sweep has checked the name
         try:
@@ -297,51 +310,127 @@ WORKER_DIED = ("worker process died while running this point (killed, e.g. by th
                "or crashed); run alone after the pool broke, it died again")
 
 
-def _run_processes(jobs: list, workers: int):
-    """Local worker processes, at most ``workers`` points in flight. A worker that dies
+class _SceneQueue:
+    """Jobs grouped by their point's scene (:func:`mjeap.sweep.design.scene_key`), in their
+    order: a worker that just finished a point takes another of the same scene (built and
+    kept in that process, :meth:`mjeap.Scene.shared`), else the first of a scene no running
+    point holds, else the first (with one point in flight per worker, the job submitted
+    after a point finishes goes to the worker that ran it)."""
+
+    def __init__(self, jobs):
+        from .design import scene_key
+        self.groups: "OrderedDict[str, deque]" = OrderedDict()
+        for job in jobs:
+            self.groups.setdefault(scene_key({**PARAMETERS, **(job[2] or {}), **job[0]}), deque()).append(job)
+
+    def __bool__(self) -> bool:
+        return bool(self.groups)
+
+    def take(self, prefer: Optional[str], busy) -> tuple:
+        """(scene key, job): of scene ``prefer`` where one is left, else as the class says."""
+        key = prefer if prefer in self.groups else next((k for k in self.groups if k not in busy),
+                                                         next(iter(self.groups)))
+        group = self.groups[key]
+        job = group.popleft()
+        if not group:
+            del self.groups[key]
+        return key, job
+
+    def put_back(self, key: str, job) -> None:
+        self.groups.setdefault(key, deque()).appendleft(job)
+        self.groups.move_to_end(key, last=False)
+
+
+def _new_pool(n: int):
+    """A pool of ``n`` worker processes: forked where the platform can (fast start, works from
+    any __main__), spawned elsewhere."""
+    from concurrent.futures import ProcessPoolExecutor
+    import multiprocessing as mp
+    ctx = mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn")
+    return ProcessPoolExecutor(max_workers=n, mp_context=ctx, initializer=_worker_init)
+
+
+class _Pools:
+    """A sweep's worker processes, kept from one phase to the next (a family's first points,
+    then the rest: what the processes built, scenes and analyses, stays there); a new pool
+    after a worker died."""
+
+    def __init__(self, workers: int):
+        self.workers, self.ex = workers, None
+
+    def get(self):
+        if self.ex is None:
+            self.ex = _new_pool(self.workers)
+        return self.ex
+
+    def drop(self) -> None:
+        """Leave a broken pool (its points in flight are run again by the caller)."""
+        if self.ex is not None:
+            self.ex.shutdown(wait=False, cancel_futures=True)
+            self.ex = None
+
+    def stop(self) -> None:
+        """Stop the workers now (Ctrl-C, SIGTERM, the caller closing)."""
+        if self.ex is not None:
+            stop_workers(self.ex)
+            self.ex = None
+
+    def close(self) -> None:
+        if self.ex is not None:
+            self.ex.shutdown(wait=True, cancel_futures=True)
+            self.ex = None
+
+
+def _run_processes(jobs: list, workers: int, pools: Optional[_Pools] = None):
+    """Local worker processes, at most ``workers`` points in flight, each worker kept on the
+    points of one scene while there are any (:class:`_SceneQueue`). A worker that dies
     breaks the pool: the points then in flight are run again one by one in a fresh
     single-worker pool (the one that kills its worker again is recorded as failed), and the
     sweep goes on in a fresh pool. Ctrl-C or SIGTERM cancels what has not started."""
-    from concurrent.futures import FIRST_COMPLETED, ProcessPoolExecutor, wait
-    from concurrent.futures.process import BrokenProcessPool
-    import multiprocessing as mp
-    # fork where there is one (fast start, works from any __main__), spawn elsewhere
-    ctx = mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn")
+    own = pools is None
+    pools = pools or _Pools(workers)
+    try:
+        yield from _run_in(pools, _SceneQueue(jobs), workers)
+    finally:
+        if own:
+            pools.close()
 
-    def pool(n):
-        return ProcessPoolExecutor(max_workers=n, mp_context=ctx, initializer=_worker_init)
 
-    pending = list(jobs)
+def _run_in(pools: _Pools, pending: _SceneQueue, workers: int):
+    """:func:`_run_processes`'s loop, in ``pools``."""
     while pending:
-        suspects, ex = [], pool(workers)
-        inflight = {}
+        suspects, ex, broken = [], pools.get(), False
+        inflight, freed = {}, []            # freed: the scenes of the workers that just finished
         try:
             while pending or inflight:
-                broken = False
                 while pending and len(inflight) < workers:
+                    key, args = pending.take(freed.pop(0) if freed else None, {k for _, k in inflight.values()})
                     try:                    # the pool may break between a finished point and this submit
-                        fut = ex.submit(evaluate, *pending[0])
+                        fut = ex.submit(evaluate, *args)
                     except BrokenProcessPool:
+                        pending.put_back(key, args)
                         broken = True
                         break
-                    inflight[fut] = pending.pop(0)
+                    inflight[fut] = args, key
+                freed.clear()
                 done, _ = wait(inflight, return_when=FIRST_COMPLETED)
                 for fut in done:
-                    args = inflight.pop(fut)
+                    args, key = inflight.pop(fut)
+                    freed.append(key)
                     try:
                         yield fut.result()
                     except BrokenProcessPool:
                         suspects.append(args)
                 if suspects or broken:
-                    suspects += list(inflight.values())
+                    suspects += [args for args, _ in inflight.values()]
                     break
         except BaseException:               # Ctrl-C, SIGTERM, the caller closing: stop the workers now
-            stop_workers(ex)
+            pools.stop()
             raise
-        else:
-            ex.shutdown(wait=not suspects, cancel_futures=True)
+        if suspects or broken:
+            pools.drop()
         for args in suspects:                      # one by one: find the point that kills
-            alone = pool(1)
+            alone = _new_pool(1)
             try:
                 yield alone.submit(evaluate, *args).result()
             except BrokenProcessPool:
@@ -359,9 +448,10 @@ def run_sweep(points: Sequence[dict], path, metrics: Sequence[str] = ("peak_to_p
     """Evaluate ``points`` and stream one CSV row per finished point to ``path``. Points
     already in the file (same ``point_id``) are skipped. ``record``: indices of points
     that also write a recording to ``rrd_dir`` (default: next to the CSV).
-    ``share_error_models`` (at an accuracy target): points differing only in LOAD_SIZE
-    start from their family's first point's error model instead of pilots of their own
-    (:func:`_with_shared_error_models`); each point's error is measured on it either way."""
+    ``share_error_models`` (at an accuracy target on the trajectory): points differing only
+    in LOAD_SIZE start from their family's first point's error model instead of pilots of
+    their own (:func:`_with_shared_error_models`); each point's error is measured on it
+    either way."""
     path = Path(path)
     if executor not in EXECUTORS:
         raise ParameterError("executor", executor, f"one of {', '.join(EXECUTORS)}")

@@ -203,17 +203,22 @@ def check_case(golden: dict) -> dict:
 
 
 def summarise(rows: List[dict]) -> dict:
-    """The claim's statistics over checked cases (one entry per case and metric)."""
+    """The claim's statistics over checked cases (one entry per case and metric): the true
+    error against the target for the metrics that are numbers (a boolean's target is its
+    decision: decided, and right where decided), the estimate against the true error for
+    all (a boolean's: its margin's)."""
     items = [(r["target"], m) for r in rows for m in r["metrics"].values()]
     true = np.array([m["true_error"] for _, m in items])
     est = np.array([m["estimated_error"] for _, m in items])
     target = np.array([t for t, _ in items])
+    number = np.array(["decided" not in m for _, m in items])
     ratio = np.where(true > 0, est / np.maximum(true, 1e-300), np.inf)
     within = ((ratio >= 1 / 3) & (ratio <= 3)) | ((true < RESOLVED * target) & (est <= target))
     booleans = [m for _, m in items if "decided" in m]
-    return {"cases": len(rows), "metric_checks": len(items),
-            "below_target": float(np.mean(true <= target)),
-            "worst_true_over_target": float(np.max(true / target)),
+    return {"cases": len(rows), "metric_checks": len(items), "number_checks": int(number.sum()),
+            "below_target": float(np.mean((true <= target)[number])),
+            "worst_true_over_target": float(np.max((true / target)[number])),
+            "boolean_margins_below_target": float(np.mean((true <= target)[~number])) if (~number).any() else None,
             "estimate_within_3x": float(np.mean(within)),
             "estimate_over_true_range": [float(ratio.min()), float(ratio[np.isfinite(ratio)].max())],
             "booleans_decided": sum(m["decided"] for m in booleans),
