@@ -11,6 +11,7 @@ import stat
 import subprocess
 import sys
 import threading
+import time
 from pathlib import Path
 
 import pytest
@@ -70,7 +71,13 @@ def test_a_fifo_gets_the_whole_output_and_stays_a_fifo(tmp_path):
     reader = threading.Thread(target=lambda: got.append(open(fifo, "rb").read()))
     reader.start()
     try:
-        r = _run(csv_path=fifo)
+        for _ in range(100):        # until the reader's open() is under way (a loaded machine is slow to start it)
+            try:
+                r = _run(csv_path=fifo)
+                break
+            except ParameterError as e:
+                assert "nobody reads it" in str(e)
+                time.sleep(0.05)
     finally:
         reader.join(timeout=60)
     assert stat.S_ISFIFO(os.stat(fifo).st_mode)

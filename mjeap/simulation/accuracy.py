@@ -374,7 +374,9 @@ def run_at_accuracy(scene, run, *, accuracy: float, duration: float, wave=None,
     (:func:`fewer_segments`), not taken from a. ``pilot_run`` (a batch: ``run`` for its
     first member only) runs the pilots on that member alone, the others then measured as
     with a given error model. Returns (result(s), scene of the chosen
-    model, report dict), the report also put in each result's ``meta['accuracy']``."""
+    model, report dict), the report also put in each result's ``meta['accuracy']``; the
+    chosen scene is shared (:meth:`mjeap.Scene.variant`): a later run of the same model in
+    this thread resets its state."""
     target = check_accuracy(accuracy)
     given = None if error_model is None else as_error_model(error_model)
     check_targetable(scene, accuracy)

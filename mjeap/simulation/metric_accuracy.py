@@ -61,6 +61,7 @@ model is run. Measured numbers: docs/concepts/accuracy.md, scripts/bench.py.
 from __future__ import annotations
 
 import math
+import threading
 from collections import OrderedDict
 import time as _time
 from dataclasses import asdict
@@ -254,6 +255,13 @@ _EYE = np.eye(3)
 #: the structure :func:`chain_kinematics` reads from a model, by (model, bodies, frame_of): a
 #: choice's runs and a map's amplitudes step the same native models. Oldest dropped past 128
 _CHAINS: "OrderedDict[tuple, tuple]" = OrderedDict()
+_CHAINS_LOCK = threading.Lock()
+
+
+def clear_chains() -> None:
+    """Forget the chain structures kept (:func:`chain_kinematics`)."""
+    with _CHAINS_LOCK:
+        _CHAINS.clear()
 
 
 def _chain_structure(model, bodies: tuple, frame_of: int):
@@ -313,13 +321,14 @@ def chain_kinematics(model, qpos: np.ndarray, bodies: Sequence[int], frame_of: i
     body moves otherwise (a joint other than one hinge through its origin, hinges on
     different axes, a rotated body below a hinge)."""
     key = (id(model), tuple(int(b) for b in bodies), int(frame_of))
-    kept = _CHAINS.get(key)
-    if kept is None or kept[0] is not model:
-        kept = _CHAINS[key] = (model, _chain_structure(model, key[1], key[2]))
-        while len(_CHAINS) > 128:
-            _CHAINS.popitem(last=False)
-    else:
-        _CHAINS.move_to_end(key)
+    with _CHAINS_LOCK:
+        kept = _CHAINS.get(key)
+        if kept is None or kept[0] is not model:
+            kept = _CHAINS[key] = (model, _chain_structure(model, key[1], key[2]))
+            while len(_CHAINS) > 128:
+                _CHAINS.popitem(last=False)
+        else:
+            _CHAINS.move_to_end(key)
     structure = kept[1]
     if structure is None:
         return None
@@ -456,14 +465,19 @@ def _extrapolate(q: float, q_2h: float, q_4h: float) -> Optional[tuple]:
     extrapolation at order 1 (backward Euler, the drive held over the step): d1 = q - q_2h,
     d2 = q_2h - q_4h; where the observed order log2(d2 / d1) is within
     EXTRAPOLATION_ORDERS the value is q + d1 (its first-order error removed) and its error
-    |(q + d1) - (q_2h + d2)| / 3 (order 2), at least EXTRAPOLATION_FLOOR x |d1|; None
-    outside the window (not in the asymptotic range: the run's own value stands)."""
+    |(q + d1) - (q_2h + d2)| / 3 (order 2) plus |d1| |1 - 1 / (2^p - 1)| (the order-p
+    sequence's limit against order 1's), at least EXTRAPOLATION_FLOOR x |d1|; None outside
+    the window (not in the asymptotic range: the run's own value stands)."""
     d1, d2 = q - q_2h, q_2h - q_4h
     if d1 == 0 or not d2 / d1 > 0:
         return None
-    if not EXTRAPOLATION_ORDERS[0] <= math.log2(d2 / d1) <= EXTRAPOLATION_ORDERS[1]:
+    p = math.log2(d2 / d1)
+    if not EXTRAPOLATION_ORDERS[0] <= p <= EXTRAPOLATION_ORDERS[1]:
         return None
-    return q + d1, max(abs(2 * d1 - d2) / 3.0, EXTRAPOLATION_FLOOR * abs(d1))
+    # the h^2 remainder, and what assuming order 1 leaves where the observed order is p: the
+    # limit of an order-p sequence is q + d1 / (2^p - 1)
+    err = abs(2 * d1 - d2) / 3.0 + abs(d1) * abs(1.0 - 1.0 / (2.0 ** p - 1.0))
+    return q + d1, max(err, EXTRAPOLATION_FLOOR * abs(d1))
 
 
 def _observed_order(q: float, q_2h: float, q_4h: float) -> Optional[float]:
@@ -500,9 +514,9 @@ def _evaluate(metrics, runs, period, duration, step) -> Dict[str, dict]:
             row["observed_step_order"] = _observed_order(q[0], q[1], q4)
         if x is not None:
             row["run_value"] = q[0]
-        if name == "returns":
+        if name == "returns":       # decided beyond its error, and on the run's own side where extrapolated
             margin = _relative(value, scale)
-            row.update(margin=margin, decided=abs(margin) > e)
+            row.update(margin=margin, decided=abs(margin) > e and (x is None or (value > 0) == (q[0] > 0)))
         out[name] = row
     return out
 
@@ -538,7 +552,9 @@ def run_metrics_at_accuracy(scene, run, *, metrics: Sequence[str], accuracy: flo
     ``drive`` (the question's drive) bounds the relaxed step. ``error_model``:
     (a, b) of a similar question (a sweep's earlier point) choosing the first model. Returns
     (result, scene of the chosen model, report), the report also in
-    ``result.meta['accuracy']`` with one entry per metric under ``'metrics'``."""
+    ``result.meta['accuracy']`` with one entry per metric under ``'metrics'``. The chosen
+    scene is shared (:meth:`mjeap.Scene.variant`): a later run of the same model in this
+    thread resets its state."""
     target = check_accuracy(accuracy)
     names = check_metrics(metrics)
     given = None if error_model is None else as_error_model(error_model)
@@ -638,8 +654,9 @@ def run_metrics_at_accuracy(scene, run, *, metrics: Sequence[str], accuracy: flo
     while need > 0 and refinements < MAX_REFINEMENTS:
         em = ErrorModel(max(max(m["segments_error"] for m in found.values()) * model.segments ** 2, 1e-12),
                         max(max(m["step_error"] for m in found.values()) / model.timestep, 1e-12))
-        nxt = refine(em, need, model, any(not m["extrapolated"] for m in found.values()
-                                          if "observed_step_order" in m))
+        nxt = refine(em, need, model, any(
+            "observed_step_order" in m and not m["extrapolated"] and
+            (not m["decided"] if "decided" in m else m["estimated_error"] > target) for m in found.values()))
         if duration / nxt.timestep > MAX_MODEL_STEPS or \
                 (nxt.segments <= model.segments and nxt.timestep >= model.timestep):
             break
@@ -656,9 +673,16 @@ def run_metrics_at_accuracy(scene, run, *, metrics: Sequence[str], accuracy: flo
                     "wall_time_s": _time.perf_counter() - t})
         chosen, decided_by = scene, "the scene's own model: undecided by the chosen model's estimate"
         for k in undecided:
-            found[k].update(value=metric_quantity(k, result, period), decided=True, decided_by=decided_by)
-    worst = max(m["estimated_error"] for m in found.values())
-    met = all(m["decided"] if "decided" in m else m["estimated_error"] <= target for m in found.values())
+            value = metric_quantity(k, result, period)
+            for gone in ("run_value", "observed_step_order"):
+                found[k].pop(gone, None)
+            found[k].update(value=value, margin=_relative(value, metric_scale(k, result, value, period, duration)),
+                            extrapolated=False, decided=True, decided_by=decided_by)
+    # the error reported and held to the target: the numbers' (a boolean's target is its decision)
+    numbers = [m["estimated_error"] for m in found.values() if "decided" not in m]
+    worst = max(numbers or [m["estimated_error"] for m in found.values()])
+    met = worst <= target if numbers else True
+    met = met and all(m["decided"] for m in found.values() if "decided" in m)
     h = model.timestep
     damped = None
     if h > scene.choice.rayleigh_beta and model.integrator == "discrete":
@@ -671,7 +695,10 @@ def run_metrics_at_accuracy(scene, run, *, metrics: Sequence[str], accuracy: flo
               "relaxed_step_refused": None if relaxed is not None else why, "damped_modes": damped,
               "decided_by": decided_by,
               "estimate": "each metric on the chosen run against companions of the same segments at 2 h (step, "
-                          "order 1 assumed) and of fewer segments at 2 h (segments, order 2), in quadrature",
+                          "order 1 assumed) and of fewer segments at 2 h (segments, order 2), in quadrature; with "
+                          "relaxed steps also at 4 h: Richardson-extrapolated where the observed order is near 1",
+              "values_from": ("the chosen model's runs (the numbers); the trajectory and the undecided booleans "
+                              "from the scene's own model" if decided_by else "the chosen model's runs"),
               "error_model": {"spatial_a": em.spatial, "temporal_b_per_s": em.temporal,
                               "form": "e = sqrt((a / N^2)^2 + (b h)^2)",
                               "pilots": "given" if given is not None else "none: measured on the runs"},

@@ -161,6 +161,7 @@ ANALYSIS_CACHE_BYTES = 64 * 2**20
 #: or a point scene left with a tip load, is built again. Oldest dropped past SHARED_SCENES
 _SHARED = threading.local()
 SHARED_SCENES = 64
+SHARED_SCENE_BYTES = 256 * 2**20
 
 
 def _shared_scenes() -> "OrderedDict[tuple, Scene]":
@@ -170,11 +171,19 @@ def _shared_scenes() -> "OrderedDict[tuple, Scene]":
     return cache
 
 
+def _orientation_key(v):
+    if isinstance(v, str):
+        return v
+    a = np.asarray(v, dtype=float)
+    return a.shape, a.tobytes()
+
+
 def _shared(args: dict, chosen_model: bool) -> "Scene":
     """The scene of Scene's keywords ``args`` (the actuator an object) from this thread's
-    cache, built and kept there where missing or no longer as built."""
-    key = (chosen_model,) + tuple((k, id(v) if k == "actuator" else np.asarray(v).tobytes()
-                                   if k == "orientation" and not isinstance(v, str) else v)
+    cache, built and kept there where missing or no longer as built. The cache holds at most
+    SHARED_SCENES scenes and SHARED_SCENE_BYTES of compiled models (three per scene counted:
+    its own, its data, a native model), the oldest dropped first."""
+    key = (chosen_model,) + tuple((k, id(v) if k == "actuator" else _orientation_key(v) if k == "orientation" else v)
                                   for k, v in sorted(args.items()))
     cache = _shared_scenes()
     s = cache.get(key)
@@ -184,7 +193,8 @@ def _shared(args: dict, chosen_model: bool) -> "Scene":
         s.chosen_model = chosen_model
         Scene.__init__(s, **args)
         cache[key] = s
-        while len(cache) > SHARED_SCENES:
+        while len(cache) > 1 and (len(cache) > SHARED_SCENES or
+                                  sum(3 * mujoco.mj_sizeModel(x.model) for x in cache.values()) > SHARED_SCENE_BYTES):
             cache.popitem(last=False)
     else:
         cache.move_to_end(key)
@@ -192,11 +202,13 @@ def _shared(args: dict, chosen_model: bool) -> "Scene":
 
 
 def clear_build_caches() -> None:
-    """Forget the analyses, layouts, shared scenes and native models' stability that scenes
-    share (a benchmark's cold start)."""
+    """Forget the analyses, layouts, this thread's shared scenes, the chain structures and
+    native models' stability that scenes share (a benchmark's cold start)."""
+    from .metric_accuracy import clear_chains
     from .native_model import clear_stable
     _ANALYSES.clear()
     _shared_scenes().clear()
+    clear_chains()
     clear_layouts()
     clear_stable()
 

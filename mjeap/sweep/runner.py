@@ -243,8 +243,8 @@ def _with_shared_error_models(executor: str, workers: int, scheduler: Optional[s
     question but for LOAD_SIZE) runs first with its own pilots; the family's other points
     start from its error model (a, b) instead of pilots of their own, their error still
     measured on each (:func:`mjeap.simulation.accuracy.run_at_accuracy`). Points of a
-    family whose first point failed run their own pilots. Points without a target run
-    beside the first points."""
+    family whose first point failed run their own pilots. Points without a target, or with
+    one on their metrics (no pilots to share, :func:`_family`), run beside the first points."""
     first, rest, seen, lead_family = [], [], set(), {}     # lead_family: a first point's id -> its family
     for job in jobs:
         key = _family(job)
@@ -267,6 +267,10 @@ def _with_shared_error_models(executor: str, workers: int, scheduler: Optional[s
             yield row
         yield from _submit_all(executor, workers, scheduler,
                                [tuple(job[:4]) + (models.get(key),) for key, job in rest], pools)
+    except BaseException:       # Ctrl-C, SIGTERM, the caller closing: stop the workers now
+        if pools is not None:
+            pools.stop()
+        raise
     finally:
         if pools is not None:
             pools.close()
