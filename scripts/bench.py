@@ -526,14 +526,15 @@ def bench_accuracy(claim_cases=12):
     return out
 
 
-def bench_metric_map(masses=(20, 40, 60, 70, 74, 78, 82, 100), amplitudes=(0.25, 1.0, 1.5), rounds=2):
+def bench_metric_map(masses=(20, 40, 60, 70, 74, 78, 82, 100), amplitudes=(0.25, 1.0, 1.5), rounds=2, wide=(12, 8)):
     """The stability map (pedot-micro standing, 30 s points) at accuracy 1e-2 on its metrics
     (returns, peak_to_peak: mjeap.simulation.metric_accuracy, relaxed steps) against the
     default model on the same points, serial and on 2 workers, interleaved in ``rounds``
     rounds (the machine is shared), each run from cold (the scenes' shared analyses cleared):
     points per second, their ratio, returns agreement, the
-    largest peak-to-peak deviation from the default, the simulated edges; and where the time
-    of an accuracy point goes (its runs)."""
+    largest peak-to-peak deviation from the default, the simulated edges; a wider map
+    (``wide``: masses x amplitudes) on 2 workers, once each; and where the time of an
+    accuracy point goes (its runs)."""
     import tempfile
     from mjeap.analysis.stability import MAP_BASE, simulated_edges
     from mjeap.simulation.scene import clear_build_caches
@@ -573,6 +574,27 @@ def bench_metric_map(masses=(20, 40, 60, 70, 74, 78, 82, 100), amplitudes=(0.25,
         v = np.array([float(r["amplitude"]) for r in rs])
         ok = np.array([r["returns"] == "True" for r in rs])
         out[f"edges_mg_{label}"] = {f"{a:g} V": e for a, e in simulated_edges(m, v, ok).items()}
+    # a wider map on 2 workers, once each: the fixed costs (a pool, the costliest point's tail)
+    # spread over more points
+    wide_pts = grid(payload_mass=[float(m) * 1e-6 for m in np.linspace(10, 110, wide[0])],
+                    amplitude=[float(a) for a in np.linspace(0.25, 1.5, wide[1])])
+    wide_rows = {}
+    with tempfile.TemporaryDirectory() as d:
+        for label, extra in (("default", {}), ("accuracy_1e-2", {"accuracy": 1e-2})):
+            clear_build_caches()
+            res = run_sweep(wide_pts, Path(d) / f"wide_{label}.csv", metrics=("returns", "peak_to_peak"),
+                            base={**MAP_BASE, **extra}, executor="processes", workers=2, progress=False)
+            wide_rows[label] = (len(wide_pts) / res.wall_s, read_results(Path(d) / f"wide_{label}.csv"))
+    ref = {(r["payload_mass"], r["amplitude"]): r for r in wide_rows["default"][1]}
+    acc = wide_rows["accuracy_1e-2"][1]
+    out["wide_map_2_workers"] = {
+        "points": f"{len(wide_pts)} ({wide[0]} masses 10-110 mg x {wide[1]} amplitudes 0.25-1.5 V)",
+        "default_points_per_s": wide_rows["default"][0], "accuracy_points_per_s": wide_rows["accuracy_1e-2"][0],
+        "ratio": wide_rows["accuracy_1e-2"][0] / wide_rows["default"][0],
+        "returns_equal": f"{sum(r['returns'] == ref[(r['payload_mass'], r['amplitude'])]['returns'] for r in acc)} "
+                         f"of {len(acc)}",
+        "max_peak_to_peak_deviation": max(abs(float(r["peak_to_peak"]) / float(
+            ref[(r["payload_mass"], r["amplitude"])]["peak_to_peak"]) - 1) for r in acc)}
     from mjeap import Scene, rollout
     s = Scene("pedot-micro", orientation="up", payload="76mg@6.27mm")
     t0 = time.perf_counter()

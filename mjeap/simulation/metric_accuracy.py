@@ -617,12 +617,14 @@ def run_metrics_at_accuracy(scene, run, *, metrics: Sequence[str], accuracy: flo
         """The cheapest next model by the error model: :func:`_choose`'s, or ``last``'s
         segments at an integer fraction of its step (its runs then serve as companions);
         where ``last``'s step was outside the asymptotic range (``pre_asymptotic``: a
-        metric's observed order outside EXTRAPOLATION_ORDERS), half its step (the runs at h
-        and 2 h then serve as companions) and the segments the error model's spatial part
-        needs."""
+        metric's observed order outside EXTRAPOLATION_ORDERS), half its step: at its
+        segments where the error model's spatial part allows them (the runs at h and 2 h
+        then serve as companions), else at the segments that part needs."""
         if pre_asymptotic:
-            return _choose(scene, ErrorModel(em.spatial, 0.0), need, duration, grid,
-                           min(h_cap, last.timestep / 2), widest)
+            h = min(h_cap, last.timestep / 2)
+            if em.spatial / last.segments ** 2 <= need / SAFETY:
+                return Model(last.segments, h, _integrator(scene, h))
+            return _choose(scene, ErrorModel(em.spatial, 0.0), need, duration, grid, h, widest)
         best = _choose(scene, em, need, duration, grid, h_cap, widest)
         for k in (2, 3, 4, 6, 8):
             m = Model(last.segments, last.timestep / k, last.integrator)
@@ -652,11 +654,11 @@ def run_metrics_at_accuracy(scene, run, *, metrics: Sequence[str], accuracy: flo
     refinements, decided_by = 0, None
     need = _needs(found, target)
     while need > 0 and refinements < MAX_REFINEMENTS:
-        em = ErrorModel(max(max(m["segments_error"] for m in found.values()) * model.segments ** 2, 1e-12),
-                        max(max(m["step_error"] for m in found.values()) / model.timestep, 1e-12))
-        nxt = refine(em, need, model, any(
-            "observed_step_order" in m and not m["extrapolated"] and
-            (not m["decided"] if "decided" in m else m["estimated_error"] > target) for m in found.values()))
+        # the metrics that ask for more: numbers beyond the target, undecided booleans
+        short = [m for m in found.values() if (not m["decided"] if "decided" in m else m["estimated_error"] > target)]
+        em = ErrorModel(max(max(m["segments_error"] for m in short) * model.segments ** 2, 1e-12),
+                        max(max(m["step_error"] for m in short) / model.timestep, 1e-12))
+        nxt = refine(em, need, model, any("observed_step_order" in m and not m["extrapolated"] for m in short))
         if duration / nxt.timestep > MAX_MODEL_STEPS or \
                 (nxt.segments <= model.segments and nxt.timestep >= model.timestep):
             break
