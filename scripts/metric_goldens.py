@@ -4,9 +4,11 @@ written to tests/golden/metric_accuracy.json (tests/test_metric_accuracy.py read
 
     python scripts/metric_goldens.py [--seed 36] [--cases 40] [--out tests/golden/metric_accuracy.json]
     python scripts/metric_goldens.py --geometry [--out tests/golden/metric_accuracy_geometry.json]
+    python scripts/metric_goldens.py --column-band [--out tests/golden/metric_accuracy_column.json]
 
 With --geometry: the converged peak_to_peak of a file actuator's length sweep
-(mjeap.validation.metric_claim.GEOMETRY) instead.
+(mjeap.validation.metric_claim.GEOMETRY) instead; with --column-band: the stability map's
+cases about the instantaneous column load (mjeap.validation.metric_claim.COLUMN_BAND).
 """
 import argparse
 import json
@@ -16,14 +18,24 @@ from pathlib import Path
 
 def main(argv=None):
     from mjeap.io.commandline import arg_integer, parse_args
-    from mjeap.validation.metric_claim import converged, draw_cases, geometry_goldens
+    from mjeap.validation.metric_claim import column_band_cases, converged, draw_cases, geometry_goldens
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--seed", type=arg_integer(0), default=36)
     ap.add_argument("--cases", type=arg_integer(1, 1000), default=40)
     ap.add_argument("--geometry", action="store_true", help="the length sweep's goldens instead of the cases'")
-    ap.add_argument("--out", default=None, help="default: tests/golden/metric_accuracy[_geometry].json")
+    ap.add_argument("--column-band", action="store_true", help="the column band's goldens instead of the cases'")
+    ap.add_argument("--out", default=None, help="default: tests/golden/metric_accuracy[_geometry|_column].json")
     a = parse_args(ap, argv)
     root = Path(__file__).resolve().parents[1]
+    if a.column_band:
+        out = a.out or str(root / "tests/golden/metric_accuracy_column.json")
+        goldens = []
+        for case in column_band_cases():
+            goldens.append(converged(case))
+            print(case.describe(), flush=True)
+        Path(out).write_text(json.dumps({"cases": goldens}, indent=1, default=float) + "\n")
+        print(f"wrote {out}")
+        return
     if a.geometry:
         out = a.out or str(root / "tests/golden/metric_accuracy_geometry.json")
         Path(out).write_text(json.dumps(geometry_goldens(root), indent=1, default=float) + "\n")

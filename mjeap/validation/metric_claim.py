@@ -37,7 +37,7 @@ from ..simulation.rollout import rollout
 from ..simulation.scene import Scene
 
 __all__ = ["Case", "draw_cases", "converged", "check_case", "summarise", "GEOMETRY", "geometry_goldens",
-           "check_geometry"]
+           "check_geometry", "COLUMN_BAND", "column_band_cases"]
 
 REFERENCE_SEGMENTS = 40
 #: a true error below this fraction of the target counts as 'within 3 x' of any estimate
@@ -59,6 +59,20 @@ def _map_case(rng) -> Case:
     amp = float(rng.uniform(0.25, 1.5))
     return Case("pedot-micro", "up", f"{mass:.2f}mg@6.27mm", f"square:{amp:.3g}V@0.1Hz", 30.0,
                 float(10 ** rng.uniform(-3, math.log10(5e-2))), ("returns", "peak_to_peak"))
+
+
+#: the stability map's band about the instantaneous column load (131.7 mg), where the first
+#: mode softens towards zero (or the straight beam grows away) and the relaxed step follows
+#: it instead of damping it (mjeap.simulation.metric_accuracy.RESOLVED_MODE): mass (mg),
+#: amplitude (V), target
+COLUMN_BAND = ((118.0, 1.5, 1e-2), (124.0, 0.25, 3e-3), (129.3, 1.0, 1e-2), (131.7, 0.5, 2e-2),
+               (134.5, 1.5, 5e-3), (140.0, 0.75, 1e-2), (150.0, 0.25, 3e-2))
+
+
+def column_band_cases() -> List[Case]:
+    """:data:`COLUMN_BAND` as cases (square 0.1 Hz, 30 s; returns and peak_to_peak)."""
+    return [Case("pedot-micro", "up", f"{m:.2f}mg@6.27mm", f"square:{a:.3g}V@0.1Hz", 30.0, t,
+                 ("returns", "peak_to_peak")) for m, a, t in COLUMN_BAND]
 
 
 def _varied_case(rng) -> Case:
