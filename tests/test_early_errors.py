@@ -204,8 +204,11 @@ def _interrupt(argv, sig, after=4.0, group=False):
     """Start ``argv``, send ``sig`` after ``after`` s (to its process group, as a terminal's
     Ctrl-C does, with ``group``), and return (exit code, stderr, seconds it took to stop)."""
     env = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
+    # the child takes SIGINT's default action (Python's KeyboardInterrupt) even where this run
+    # inherited it ignored (started as a background job without job control, as a CI
+    # runner's shell may): an ignored disposition passes through exec
     p = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, env=env,
-                         start_new_session=group)
+                         start_new_session=group, preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     time.sleep(after)
     assert p.poll() is None, "finished before the interrupt"
     os.killpg(p.pid, sig) if group else p.send_signal(sig)
