@@ -489,12 +489,10 @@ def _extrapolate(q: float, q_2h: float, q_4h: float) -> Optional[tuple]:
     |(q + d1) - (q_2h + d2)| / 3 (order 2) plus |d1| |1 - 1 / (2^p - 1)| (the order-p
     sequence's limit against order 1's), at least EXTRAPOLATION_FLOOR x |d1|; None outside
     the window (not in the asymptotic range: the run's own value stands)."""
+    p = _observed_order(q, q_2h, q_4h)
+    if p is None or not EXTRAPOLATION_ORDERS[0] <= p <= EXTRAPOLATION_ORDERS[1]:
+        return None
     d1, d2 = q - q_2h, q_2h - q_4h
-    if d1 == 0 or not d2 / d1 > 0:
-        return None
-    p = math.log2(d2 / d1)
-    if not EXTRAPOLATION_ORDERS[0] <= p <= EXTRAPOLATION_ORDERS[1]:
-        return None
     # the h^2 remainder, and what assuming order 1 leaves where the observed order is p: the
     # limit of an order-p sequence is q + d1 / (2^p - 1)
     err = abs(2 * d1 - d2) / 3.0 + abs(d1) * abs(1.0 - 1.0 / (2.0 ** p - 1.0))
@@ -707,8 +705,7 @@ def run_metrics_at_accuracy(scene, run, *, metrics: Sequence[str], accuracy: flo
     # the error reported and held to the target: the numbers' (a boolean's target is its decision)
     numbers = [m["estimated_error"] for m in found.values() if "decided" not in m]
     worst = max(numbers or [m["estimated_error"] for m in found.values()])
-    met = worst <= target if numbers else True
-    met = met and all(m["decided"] for m in found.values() if "decided" in m)
+    met = all(m["decided"] if "decided" in m else m["estimated_error"] <= target for m in found.values())
     h = model.timestep
     damped = None
     if h > scene.choice.rayleigh_beta and model.integrator == "discrete":
