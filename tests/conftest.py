@@ -9,7 +9,8 @@ import pytest  # noqa: E402
 #: the package are tests/test_layers.py's; ``contracts`` holds the failure-behaviour classes that
 #: cut across them. tests/test_docs.py checks that every test file is here and in the docs' table.
 LAYER_FILES = {
-    "foundation": ("test_layers", "test_encapsulation", "test_errors", "test_units", "test_versions", "test_docs"),
+    "foundation": ("test_layers", "test_encapsulation", "test_errors", "test_units", "test_versions", "test_docs",
+                   "test_caching"),
     "io": ("test_output_paths", "test_output_safety", "test_recordings"),
     "model": ("test_section", "test_analytical", "test_lti", "test_statics", "test_dynamics", "test_axial",
               "test_rod", "test_assets", "test_actuator_files"),

@@ -7,10 +7,12 @@ the sources do not give. :func:`get_actuator` takes a catalog id or a file's pat
 from __future__ import annotations
 
 import dataclasses
+import hashlib
 import os
 from pathlib import Path
 from typing import Dict
 
+from ..caching import BoundedCache
 from ..errors import ParameterError, UnknownNameError
 from .actuator import Actuator, Layer, Planform, Sourced, validate_actuator  # noqa: F401  (the catalog's types)
 from .actuator_file import is_actuator_file, read_actuator
@@ -60,7 +62,7 @@ def get_actuator(name) -> Actuator:
     if isinstance(name, Actuator):
         return validate_actuator(name)
     if is_actuator_file(name):
-        return read_actuator(name)
+        return file_actuator(name)
     if not isinstance(name, str):
         raise ParameterError("actuator", name, "a catalog id, an actuator file's path (.toml) or an Actuator")
     if os.path.exists(name):
@@ -72,6 +74,27 @@ def get_actuator(name) -> Actuator:
         return CATALOG[name]
     except KeyError:
         raise UnknownNameError("actuator", str(name), CATALOG) from None
+
+
+#: actuator files read, by the path given, the file it resolves to and a digest of its bytes:
+#: the same file read again is the same Actuator object, so every cache keyed on the actuator
+#: (layouts, analyses, shared scenes) hits for a file as it does for a catalog id
+_FILES = BoundedCache("actuator files", max_entries=64, locked=True)
+
+
+def file_actuator(path) -> Actuator:
+    """The Actuator of the actuator file ``path`` (:func:`read_actuator`), one object per
+    file content: read again, an unchanged file gives the object it gave before; a changed
+    one is read anew."""
+    p = Path(path)
+    try:
+        data = p.read_bytes() if p.is_file() else None
+    except OSError:
+        data = None
+    if data is None:                    # read_actuator says what is wrong with it
+        return read_actuator(path)
+    key = (str(path), os.path.realpath(p), hashlib.blake2b(data, digest_size=16).digest())
+    return _FILES.get_or_build(key, lambda: read_actuator(path))
 
 
 def check_actuator_files(names) -> None:

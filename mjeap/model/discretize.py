@@ -10,7 +10,6 @@ and converges at first order only).
 """
 from __future__ import annotations
 
-from collections import OrderedDict
 from dataclasses import dataclass
 import re
 from typing import Optional, Tuple
@@ -18,6 +17,7 @@ from typing import Optional, Tuple
 import numpy as np
 
 from .actuator import Actuator
+from ..caching import BoundedCache
 from ..errors import ParameterError, check_positive, check_range
 
 #: density used for a payload whose size is not given: sintered NdFeB, as the magnets
@@ -206,31 +206,21 @@ def discretize(act: Actuator, segments: int) -> BeamLayout:
 #: layouts already built, keyed on the actuator object (held in the entry, so its id stays
 #: its own while cached; actuators are frozen) and the segment count: a sweep's or an
 #: accuracy target's many models of one actuator share them. Oldest dropped past LAYOUT_CACHE_SIZE
-_LAYOUTS: "OrderedDict[tuple, tuple]" = OrderedDict()
 LAYOUT_CACHE_SIZE = 64
+_LAYOUTS = BoundedCache("layouts", max_entries=LAYOUT_CACHE_SIZE, locked=True)
+
+
+def _read_only(layout: BeamLayout) -> BeamLayout:
+    for value in layout.__dict__.values():
+        if isinstance(value, np.ndarray):
+            value.flags.writeable = False
+    return layout
 
 
 def shared_layout(act: Actuator, segments: int) -> BeamLayout:
     """:func:`discretize` of ``act`` with ``segments`` hinges, built once per actuator object
     and segment count and shared (its arrays read-only): the same layout, bit for bit."""
-    key = (id(act), segments)
-    hit = _LAYOUTS.get(key)
-    if hit is not None and hit[0] is act:
-        _LAYOUTS.move_to_end(key)
-        return hit[1]
-    layout = discretize(act, segments)
-    for value in layout.__dict__.values():
-        if isinstance(value, np.ndarray):
-            value.flags.writeable = False
-    _LAYOUTS[key] = (act, layout)
-    if len(_LAYOUTS) > LAYOUT_CACHE_SIZE:
-        _LAYOUTS.popitem(last=False)
-    return layout
-
-
-def clear_layouts() -> None:
-    """Forget the layouts :func:`shared_layout` holds (a benchmark's cold start)."""
-    _LAYOUTS.clear()
+    return _LAYOUTS.get_or_build(segments, lambda: _read_only(discretize(act, segments)), owner=act)
 
 
 def check_payload(payload: Optional[Payload], layout: BeamLayout) -> None:

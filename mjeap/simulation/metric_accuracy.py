@@ -67,8 +67,6 @@ model is run. Measured numbers: docs/concepts/accuracy.md, scripts/bench.py.
 from __future__ import annotations
 
 import math
-import threading
-from collections import OrderedDict
 import time as _time
 from dataclasses import asdict
 from typing import Dict, List, Optional, Sequence
@@ -77,6 +75,7 @@ import mujoco
 import numpy as np
 from mujoco import rollout as mj_rollout
 
+from ..caching import BoundedCache
 from ..errors import ParameterError
 from ..model.modes import modal_frequencies
 from .accuracy import (SAFETY, ErrorModel, Model, as_error_model, check_accuracy, check_targetable, choose_model,
@@ -275,14 +274,7 @@ _EYE = np.eye(3)
 
 #: the structure :func:`chain_kinematics` reads from a model, by (model, bodies, frame_of): a
 #: choice's runs and a map's amplitudes step the same native models. Oldest dropped past 128
-_CHAINS: "OrderedDict[tuple, tuple]" = OrderedDict()
-_CHAINS_LOCK = threading.Lock()
-
-
-def clear_chains() -> None:
-    """Forget the chain structures kept (:func:`chain_kinematics`)."""
-    with _CHAINS_LOCK:
-        _CHAINS.clear()
+_CHAINS = BoundedCache("chain structures", max_entries=128, locked=True)
 
 
 def _chain_structure(model, bodies: tuple, frame_of: int):
@@ -341,16 +333,8 @@ def chain_kinematics(model, qpos: np.ndarray, bodies: Sequence[int], frame_of: i
     ancestors' offsets summed, one matrix product) for all samples together. None where a
     body moves otherwise (a joint other than one hinge through its origin, hinges on
     different axes, a rotated body below a hinge)."""
-    key = (id(model), tuple(int(b) for b in bodies), int(frame_of))
-    with _CHAINS_LOCK:
-        kept = _CHAINS.get(key)
-        if kept is None or kept[0] is not model:
-            kept = _CHAINS[key] = (model, _chain_structure(model, key[1], key[2]))
-            while len(_CHAINS) > 128:
-                _CHAINS.popitem(last=False)
-        else:
-            _CHAINS.move_to_end(key)
-    structure = kept[1]
+    key = (tuple(int(b) for b in bodies), int(frame_of))
+    structure = _CHAINS.get_or_build(key, lambda: (_chain_structure(model, *key),), owner=model)[0]
     if structure is None:
         return None
     hinges, offsets, rotating, parent, picked, frame_at, (f, a) = structure

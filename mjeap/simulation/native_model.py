@@ -3,12 +3,12 @@ engine (:mod:`mjeap.engines.native`) steps."""
 from __future__ import annotations
 
 import hashlib
-from collections import OrderedDict
 
 import mujoco
 import numpy as np
 
 from .part import ActuatorPart
+from ..caching import BoundedCache
 from ..engines.native import why_not
 from ..errors import ParameterError
 from ..model.fields import add_units, apply_dof_damping
@@ -21,13 +21,8 @@ __all__ = ["NativeModel"]
 #: drive's elements) and the integrator. The same model built again (an accuracy target's
 #: model at the next point of a sweep, another amplitude) skips the check, whose answer it
 #: already has. Oldest dropped past STABLE_CACHE_SIZE
-_STABLE: "OrderedDict[tuple, None]" = OrderedDict()
 STABLE_CACHE_SIZE = 512
-
-
-def clear_stable() -> None:
-    """Forget which native models were found stable."""
-    _STABLE.clear()
+_STABLE = BoundedCache("stable native models", max_entries=STABLE_CACHE_SIZE, locked=True)
 
 
 def _content_key(model: mujoco.MjModel, integrator: str) -> tuple:
@@ -70,17 +65,14 @@ class NativeModel:
         must not make the linearised step map unstable at that timestep (a model already
         found stable, by its content, is not checked again)."""
         key = _content_key(self.model, self.scene.integrator)
-        if key in _STABLE:
-            _STABLE.move_to_end(key)
+        if _STABLE.get(key):
             return
         lin = linearize(self.model)
         rho = spectral_radius(lin, self.model.dof_damping, self.model.opt.timestep, self.scene.integrator)
         if rho > 1.0 + 1e-9:
             raise ParameterError("timestep", self.scene.timestep, "a timestep at which the native drive is stable",
                                  f"spectral radius {rho:.6g} of the native model's step map")
-        _STABLE[key] = None
-        if len(_STABLE) > STABLE_CACHE_SIZE:
-            _STABLE.popitem(last=False)
+        _STABLE.put(key, True)
 
     def reset(self, initial_curvature: float = 0.0) -> None:
         """Rest at a uniform arc of ``initial_curvature`` (1/m), the drive state at rest there;

@@ -43,9 +43,7 @@ Damping and timestep are derived from the compiled model, never tuned by hand:
 from __future__ import annotations
 
 import math
-import threading
 import warnings
-from collections import OrderedDict
 from dataclasses import dataclass
 from typing import Optional, Union
 
@@ -54,9 +52,10 @@ import numpy as np
 import scipy.linalg
 
 from .accuracy import check_accuracy
+from ..caching import BoundedCache, clear_caches
 from ..errors import DivergenceError, ParameterError, check_positive, check_range
 from ..model.catalog import Actuator, get_actuator
-from ..model.discretize import BeamLayout, Payload, check_payload, clamp_rotation, clear_layouts, shared_layout
+from ..model.discretize import BeamLayout, Payload, check_payload, clamp_rotation, shared_layout
 from ..model.fields import apply_dof_damping
 from ..model.mjcf import build_spec, get_builder
 from ..model.modes import modal_frequencies, stability_limit
@@ -149,9 +148,10 @@ class _BeamAnalysis:
 #: integrator and max_bend. An accuracy target's models of one beam at different steps, and
 #: a sweep's points that differ only in their drive, share it. Oldest dropped past ANALYSIS_CACHE_SIZE
 #: entries or ANALYSIS_CACHE_BYTES of matrices (a 1000-segment beam's take ~30 MB)
-_ANALYSES: "OrderedDict[tuple, _BeamAnalysis]" = OrderedDict()
 ANALYSIS_CACHE_SIZE = 256
 ANALYSIS_CACHE_BYTES = 64 * 2**20
+_ANALYSES = BoundedCache("beam analyses", max_entries=ANALYSIS_CACHE_SIZE, max_bytes=ANALYSIS_CACHE_BYTES,
+                         nbytes=_BeamAnalysis.nbytes, locked=True)
 
 
 #: scenes built for reuse, per thread (a scene's data is its runs' state), by everything they
@@ -159,16 +159,10 @@ ANALYSIS_CACHE_BYTES = 64 * 2**20
 #: payload at every amplitude, a refinement's companions) and a sweep's point scenes
 #: (:meth:`Scene.shared`). Each run resets the state; a scene whose hinges were set by hand,
 #: or a point scene left with a tip load, is built again. Oldest dropped past SHARED_SCENES
-_SHARED = threading.local()
 SHARED_SCENES = 64
 SHARED_SCENE_BYTES = 256 * 2**20
-
-
-def _shared_scenes() -> "OrderedDict[tuple, Scene]":
-    cache = getattr(_SHARED, "cache", None)
-    if cache is None:
-        cache = _SHARED.cache = OrderedDict()
-    return cache
+_SHARED = BoundedCache("shared scenes", max_entries=SHARED_SCENES, max_bytes=SHARED_SCENE_BYTES,
+                       nbytes=lambda s: 3 * mujoco.mj_sizeModel(s.model), per_thread=True)
 
 
 def _orientation_key(v):
@@ -180,37 +174,27 @@ def _orientation_key(v):
 
 def _shared(args: dict, chosen_model: bool) -> "Scene":
     """The scene of Scene's keywords ``args`` (the actuator an object) from this thread's
-    cache, built and kept there where missing or no longer as built. The cache holds at most
-    SHARED_SCENES scenes and SHARED_SCENE_BYTES of compiled models (three per scene counted:
-    its own, its data, a native model), the oldest dropped first."""
-    key = (chosen_model,) + tuple((k, id(v) if k == "actuator" else _orientation_key(v) if k == "orientation" else v)
-                                  for k, v in sorted(args.items()))
-    cache = _shared_scenes()
-    s = cache.get(key)
-    if s is None or s.actuator is not args["actuator"] or s.part.revision or \
-            (not chosen_model and s.part.has_tip_load()):
+    cache, built and kept there where missing or no longer as built (hinges set by hand; a
+    point scene left with a tip load). The cache holds at most SHARED_SCENES scenes and
+    SHARED_SCENE_BYTES of compiled models (three per scene counted: its own, its data, a
+    native model), the oldest dropped first."""
+    key = (chosen_model,) + tuple((k, _orientation_key(v) if k == "orientation" else v)
+                                  for k, v in sorted(args.items()) if k != "actuator")
+
+    def build():
         s = Scene.__new__(Scene)
         s.chosen_model = chosen_model
         Scene.__init__(s, **args)
-        cache[key] = s
-        while len(cache) > 1 and (len(cache) > SHARED_SCENES or
-                                  sum(3 * mujoco.mj_sizeModel(x.model) for x in cache.values()) > SHARED_SCENE_BYTES):
-            cache.popitem(last=False)
-    else:
-        cache.move_to_end(key)
-    return s
+        return s
+    return _SHARED.get_or_build(key, build, owner=args["actuator"],
+                                valid=lambda s: not s.part.revision and (chosen_model or not s.part.has_tip_load()))
 
 
 def clear_build_caches() -> None:
-    """Forget the analyses, layouts, this thread's shared scenes, the chain structures and
-    native models' stability that scenes share (a benchmark's cold start)."""
-    from .metric_accuracy import clear_chains
-    from .native_model import clear_stable
-    _ANALYSES.clear()
-    _shared_scenes().clear()
-    clear_chains()
-    clear_layouts()
-    clear_stable()
+    """Forget everything built scenes share (:func:`mjeap.caching.clear_caches`: analyses,
+    layouts, every thread's shared scenes, chain structures, native models' stability): a
+    benchmark's cold start."""
+    clear_caches()
 
 
 class Scene:
@@ -292,15 +276,7 @@ class Scene:
         #: everything this scene's model was built from (the actuator by identity: see _ANALYSES)
         self.build_key = key = (id(self.actuator), self.representation, lay.segments, o, self.payload, u,
                                 self._arguments["gravity"], zeta, self.integrator, self.max_bend)
-        a = _ANALYSES.get(key)
-        if a is None or a.actuator is not self.actuator:
-            a = self._analyse(zeta)
-            _ANALYSES[key] = a
-            while len(_ANALYSES) > 1 and (len(_ANALYSES) > ANALYSIS_CACHE_SIZE or
-                                          sum(map(_BeamAnalysis.nbytes, _ANALYSES.values())) > ANALYSIS_CACHE_BYTES):
-                _ANALYSES.popitem(last=False)
-        else:
-            _ANALYSES.move_to_end(key)
+        a = _ANALYSES.get_or_build(key, lambda: self._analyse(zeta), owner=self.actuator)
         self.linearization = a.linearization
         w_el, wmax, w1, buckled, beta, h_stab = a.w_el, a.wmax, a.w1, a.buckled, a.beta, a.h_stab
         kj = lay.hinge_stiffness / u.rotational_stiffness
