@@ -40,7 +40,7 @@ periodic (stop_when_periodic=1e-2): points per second and where each stopped.
 optimize: the cost of a design optimisation beside a plain sweep of the same resolution. The
 issue's question on a uniform PZT-5H bimorph file (mjeap optimize: maximise free_deflection
 over actuator.length 5-15 mm subject to first_frequency >= 800 Hz, step:200V for 0.05 s, 20
-segments), whose optimum is known in closed form (L* from beta_1, tests/test_optimize.py):
+segments), whose optimum is known in closed form (L* from beta_1, tests/studies/test_optimize.py):
 SLSQP (3 starts) and differential evolution, evaluations, wall and their error against L*;
 beside them the grid sweep of the same two metrics whose spacing is the 1 % the test asks of
 the optimiser (2 workers), its best feasible point's error and wall, and the number of grid
@@ -635,7 +635,7 @@ def bench_early_stop(map_points=8):
     return out
 
 
-#: the optimisation bench's actuator: a uniform bimorph (tests/test_optimize.py's closed form)
+#: the optimisation bench's actuator: a uniform bimorph (tests/studies/test_optimize.py's closed form)
 BENCH_BIMORPH = (Path(__file__).resolve().parents[1] / "examples" / "actuators" / "uniform-bimorph.toml").read_text()
 
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env python
 """Regenerate assets/mjcf/: one MJCF file per catalog actuator and representation.
 
-Run after any change to the catalog or the beam builders; tests/test_assets.py fails
+Run after any change to the catalog or the beam builders; tests/validation/test_assets.py fails
 while the files are stale. Each MuJoCo writes the representations it runs: run it under
 MuJoCo 4.x for the hinge and rod files and under 3.17 for the cable files (the hinge files
 are the same from either).

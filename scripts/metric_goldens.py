@@ -1,6 +1,6 @@
 """The converged answers of the metric-accuracy claim's cases (mjeap.validation.metric_claim):
 REFERENCE_SEGMENTS segments at half each scene's default step, with their uncertainty,
-written to tests/golden/metric_accuracy.json (tests/test_metric_accuracy.py reads them).
+written to tests/golden/metric_accuracy.json (tests/simulation/test_metric_accuracy.py reads them).
 
     python scripts/metric_goldens.py [--seed 36] [--cases 40] [--out tests/golden/metric_accuracy.json]
     python scripts/metric_goldens.py --geometry [--out tests/golden/metric_accuracy_geometry.json]

@@ -1,6 +1,6 @@
 #!/usr/bin/env python
 """Converged references of the piezo bimorphs' electrical power and motional-current phase
-(trust issue, section 1): tests/golden/piezo_power.json, read by tests/test_piezo_power.py.
+(trust issue, section 1): tests/golden/piezo_power.json, read by tests/drives/test_piezo_power.py.
 
 Each case: the catalog actuator's default scene, a 20 V sine about V_bias / 2 = 100 V at
 r x f_1 (rounded so that a period is a whole number of default steps), settled for

@@ -1,47 +1,38 @@
 import os
+from pathlib import Path
 
 os.environ.setdefault("MUJOCO_GL", "disable")
 
 import pytest  # noqa: E402
 
-#: the tests grouped by layer of the package (docs/testing.md), bottom up; each test gets the
-#: marker ``layer_<name>`` of its file (``python -m pytest -m layer_drives``). The layers of
-#: the package are tests/test_layers.py's; ``contracts`` holds the failure-behaviour classes that
-#: cut across them. tests/test_docs.py checks that every test file is here and in the docs' table.
-LAYER_FILES = {
-    "foundation": ("test_layers", "test_encapsulation", "test_errors", "test_units", "test_versions", "test_docs",
-                   "test_caching"),
-    "io": ("test_output_paths", "test_output_safety", "test_recordings"),
-    "model": ("test_section", "test_analytical", "test_lti", "test_statics", "test_dynamics", "test_axial",
-              "test_rod", "test_assets", "test_actuator_files"),
-    "drives": ("test_drive_ionic", "test_drive_electrostatic", "test_drive_allocation", "test_piezo_moment",
-               "test_piezo_power", "test_pvdf_fidelity"),
-    "engines": ("test_threaded", "test_native", "test_warp"),
-    "simulation": ("test_rollout", "test_system", "test_pipeline", "test_accuracy", "test_periodic", "test_golden",
-                   "test_viewer"),
-    "analysis": ("test_identify", "test_self_sensing", "test_stability_map"),
-    "applications": ("test_sweep", "test_metric_accuracy", "test_design_sweeps", "test_optimize", "test_actuator_cli",
-                     "test_validation",
-                     "test_controllers", "test_hamr_leg", "test_environment", "test_gymnasium_env"),
-    "robots": ("test_robots", "test_gripper", "test_hamr_leg_linkage", "test_robobee_wing", "test_hamr_walk",
-               "test_hamr_walk_rest", "test_hamr_walk_loops", "test_hamr_walk_study", "test_gym_robots"),
-    "contracts": ("test_contracts", "test_early_errors", "test_silent_answers", "test_reliability", "test_registries"),
-}
-#: test file (stem) -> its layer
-LAYERS = {f: layer for layer, files in LAYER_FILES.items() for f in files}
+#: the test folders, one per floor of the package bottom up (docs/architecture.md), then
+#: ``architecture`` (the layout itself: floors, encapsulation, sizes, docs) and ``contracts``
+#: (the failure-behaviour classes that cut across the floors). A test file's folder is its
+#: layer: it gets the marker ``layer_<folder>`` (``python -m pytest -m layer_drives``); adding
+#: a test file is one edit, the file in its folder. tests/architecture/test_docs.py checks that
+#: every folder is here and in docs/testing.md's table.
+LAYERS = ("foundation", "io", "model", "drives", "engines", "simulation", "analysis", "controllers", "studies",
+          "robots", "envs", "validation", "cli", "architecture", "contracts")
+TESTS = Path(__file__).resolve().parent
+
+
+def layer_of(path) -> str:
+    """The layer of the test file at ``path``: its folder under tests/ (None where it has none)."""
+    rel = Path(path).resolve().relative_to(TESTS)
+    return rel.parts[0] if len(rel.parts) == 2 and rel.parts[0] in LAYERS else None
 
 
 def pytest_configure(config):
     config.addinivalue_line("markers", "cable: needs the cable representation (MuJoCo 3.x)")
     config.addinivalue_line("markers", "rod: needs the rod representation (MuJoCo 4.x)")
     config.addinivalue_line("markers", "dm_control: needs dm_control's Physics (MuJoCo 3.x with dm-control 1.0.50)")
-    for layer in LAYER_FILES:
-        config.addinivalue_line("markers", f"layer_{layer}: a test of the {layer} layer (tests/conftest.py LAYER_FILES)")
+    for layer in LAYERS:
+        config.addinivalue_line("markers", f"layer_{layer}: a test in tests/{layer}/ (tests/conftest.py LAYERS)")
 
 
 def pytest_collection_modifyitems(config, items):
     """On MuJoCo 4.x the cable (removed there) and dm_control's Physics (fails there) are
-    refused by mjeap, which tests/test_versions.py checks; the tests that need them are
+    refused by mjeap, which tests/foundation/test_versions.py checks; the tests that need them are
     skipped with the reason: a test marked ``cable`` or ``dm_control``, or parametrised with
     the value 'cable'. Likewise the rod (mjeap.rod) on MuJoCo 3.x, with the reason mjeap gives."""
     from mjeap.model.mjcf import BUILDERS
@@ -58,7 +49,7 @@ def pytest_collection_modifyitems(config, items):
         return [x]
 
     for item in items:
-        layer = LAYERS.get(item.path.stem)
+        layer = layer_of(item.path)
         if layer:
             item.add_marker(f"layer_{layer}")
         params = getattr(getattr(item, "callspec", None), "params", {})

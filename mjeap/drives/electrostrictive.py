@@ -40,7 +40,7 @@ SLOPES = {"pvdf-60": (4.70e-4, 1.01e-3, 1.19e-3, 1.16e-3),
           "pvdf-130": (6.00e-4, 3.57e-3, 4.53e-3, 4.92e-3)}
 FIELDS = np.array([0.0, 8.33e6, 11.67e6, 15e6])
 #: electrostrictive field coefficient Q (m^2/V^2) fitted on 60PVDF (Table 4.6, least squares
-#: with its measured 0 V stiffness; re-fitted by tests/test_pvdf_fidelity.py)
+#: with its measured 0 V stiffness; re-fitted by tests/drives/test_pvdf_fidelity.py)
 STRAIN_COEFFICIENT = 6.92e-17
 _Q = (f"fitted: least squares on 60PVDF's free tip displacements ({_T}, Table 4.6) with its measured 0 V "
       "stiffness; predicts 60PVDFHalf and 130PVDF (mjeap validate, metello2020). About 50-100 x the "

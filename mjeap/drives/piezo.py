@@ -20,7 +20,7 @@ Moment per volt, derived three ways (they agree; the factor was 1/2 before issue
    (A eps_1 summed as w_j l_j kappa_j (t_p + t_cf)/2 = w_j theta_j (t_p + t_cf) / 2):
    I_mech = sum_j Gamma_j dtheta_j/dt with Gamma_j = f31 w_j (t_p + t_cf).
 3. Reciprocity: the motional current's coefficient is dM_j/dV_sig (the electromechanical
-   energy balance; ``tests/test_piezo_moment.py`` checks it over a driven cycle).
+   energy balance; ``tests/drives/test_piezo_moment.py`` checks it over a driven cycle).
 
 So Gamma_j = f31 w_j (t_p + t_cf) N m/V per hinge and M_j = Gamma_j V_eff: the curvature
 M / (D w) = f31 (t_p + t_cf) V_eff / D is uniform even on the trapezoidal planform.
@@ -38,7 +38,7 @@ work balances exactly what its dampers dissipate (multiply the step's equation b
 (q_{k+1} - q_{k-1}) / 2: the mass and spring terms telescope over a period). So I_mech is
 sum_j Gamma_j (v_j,k + v_j,k+1) / 2, the rates before and after the step the voltage was held
 over; every engine reads it so (the threaded and native ones replay the step from the state
-before it). ``tests/test_piezo_power.py`` checks power and phase at 0.3 .. 2 f_1 against
+before it). ``tests/drives/test_piezo_power.py`` checks power and phase at 0.3 .. 2 f_1 against
 converged runs and the per-cycle energy balance.
 
 The instant of C dV/dt. The capacitive current belongs to the same instant t_k as V_k and
@@ -54,7 +54,7 @@ do work over a cycle, 24 % of the motional power at f_1 / 2 on pzt-hamr-small (n
 the second-order difference's real part is omega^4 h^3 / 4). Before the first step the first voltage is taken as
 held (no current). The charge of a voltage step, sum_k h I_C,k = C (3/2 - 1/2) Delta V, is
 C Delta V as with the backward difference, delivered over two steps (3/2 then -1/2 of it:
-the parabola's slope overshoots a jump; tests/test_piezo_power.py). A self-sensing
+the parabola's slope overshoots a jump; tests/drives/test_piezo_power.py). A self-sensing
 estimator must difference its own voltage samples the same way
 (:mod:`mjeap.controllers.self_sensing`) for beta C_fit = C to cancel the dielectric current.
 """

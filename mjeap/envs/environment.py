@@ -14,7 +14,7 @@ MuJoCo: one drive update per MuJoCo step, the voltage held over the control inte
   dm-control 1.0.50's ``Physics`` reads ``MjModel.flex_vertedge``, which 4.0 no longer has
   (:func:`mjeap.versions.dm_control_problem`).
 
-Both give the same trajectories for the same seed and actions (tests/test_environment.py).
+Both give the same trajectories for the same seed and actions (tests/envs/test_environment.py).
 The task, the physics and the dm_env environment are :mod:`mjeap.envs.dm_tracking`'s (no
 dm_control). :class:`CurvatureTrackingTask` gives the action (drive voltage, V, inside the drive's safe
 range), the observations (SI) and a configurable tracking reward, and randomises payload

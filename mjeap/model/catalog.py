@@ -26,7 +26,7 @@ SEED_003 = "Jayaram et al. 2018, Smart Mater. Struct. 27 065028 (seed 003)"
 # =========================================================================================
 # The catalog: the eight actuators of the four sources, as actuator files in the package
 # (mjeap/model/actuators/*.toml, :mod:`mjeap.model.actuator_file`), every number with its
-# source. tests/test_actuator_files.py checks them against the catalog as it was compiled
+# source. tests/model/test_actuator_files.py checks them against the catalog as it was compiled
 # here before (tests/golden/catalog_eaac59e.json).
 # =========================================================================================
 #: where the catalog's actuator files live (installed with the package)

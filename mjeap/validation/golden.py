@@ -1,5 +1,5 @@
 """Golden tip-curvature trajectories: one representative rollout per catalog actuator, kept
-downsampled as small CSV files in ``tests/golden/`` and compared by ``tests/test_golden.py``.
+downsampled as small CSV files in ``tests/golden/`` and compared by ``tests/simulation/test_golden.py``.
 
 After an intentional physics change, regenerate them and review the diff:
 
@@ -14,7 +14,7 @@ import numpy as np
 
 #: samples kept per trajectory
 SAMPLES = 200
-#: allowed deviation, as a fraction of the trajectory's range (see tests/test_golden.py)
+#: allowed deviation, as a fraction of the trajectory's range (see tests/simulation/test_golden.py)
 RTOL = 1e-5
 
 #: actuator id -> (scene keyword arguments, waveform, duration s, initial curvature 1/m, drive params)

@@ -6,7 +6,7 @@ published formula that checks the drive's moment; the continuum beam with the sa
 the drive's moment (the exact arc, an independent solution) for the chain's shape. The
 identification tool's recovery of the known truth of a simulated, noisy tip trajectory is
 shown as comparison rows: the data come from the same simulator, a round trip, not a
-reference (tests/test_identify.py tests the tool).
+reference (tests/analysis/test_identify.py tests the tool).
 """
 from __future__ import annotations
 
@@ -106,7 +106,7 @@ def identify(quick: bool = False) -> Experiment:
     fit = fit_hinge_parameters(scene, t, noisy, "step:1V", drive_params=drive_params, initial=(k0, b0))
     fitted = simulate_tip(scene, fit.stiffness, fit.damping, "step:1V", 0.3, t, drive_params=drive_params)
     round_trip = ("a round trip, not a reference: the data are simulated by the model that is fitted (the tool is "
-                  "tested in tests/test_identify.py)")
+                  "tested in tests/analysis/test_identify.py)")
     ex.check("joint stiffness k", "N m/rad", fit.stiffness, truth[0], "known truth of the simulated data",
              note=round_trip)
     ex.check("joint damping b", "N m s/rad", fit.damping, truth[1], "known truth of the simulated data",

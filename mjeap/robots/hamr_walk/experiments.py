@@ -135,7 +135,7 @@ numbers): single runs, not converged values. Re-measured with the contact of
   frequency; the transmissions' sweep on the 4-segment leg at 200 V fits 99.8 Hz and 79.8
   Hz, zeta 0.052, the model's 100 / 80 Hz, 0.05), at 20 V, 80 Hz (the lifts' resonance,
   where their open-loop lag is largest: the second-order model's 90 deg, the swings' 12.5),
-  40 cycles closed after 6: see tests/test_hamr_walk_loops.py for the lags and errors. At
+  40 cycles closed after 6: see tests/robots/test_hamr_walk_loops.py for the lags and errors. At
   80 Hz, 20 V the robot hops (above): a foot down 5 % (open loop) and 1.4-8 % (closed, two
   runs, the self-sensing controllers changed between them) of the time, duty 0.013 and
   0.003-0.021, and in its flights it tilts past UPRIGHT_DEG (open loop pitch 32 deg; closed

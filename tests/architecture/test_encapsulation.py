@@ -10,7 +10,7 @@ Allowed by name: the public API of the standard library that starts with an unde
 import ast
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 #: underscore names that are a library's public API
 PUBLIC_UNDERSCORED = {"_replace", "_asdict", "_fields", "_make", "_field_defaults", "_getframe"}
 #: the accesses issue 35 named: never on another object, whatever the module

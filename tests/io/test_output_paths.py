@@ -21,7 +21,7 @@ from mjeap.errors import OutputError, ParameterError
 from mjeap.io import outputs
 from mjeap.io.recording import read_recording
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 ENV = {**os.environ, "PYTHONPATH": os.pathsep.join([str(ROOT), os.environ.get("PYTHONPATH", "")])}
 root_only = pytest.mark.skipif(os.geteuid() != 0, reason="making a device node needs root")
 

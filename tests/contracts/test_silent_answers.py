@@ -2,7 +2,7 @@
 before any work, naming the parameter (or flag) and what is accepted.
 
 References: the equivalent one-actuator Scene (an attached beam moves as it does, round-off
-apart: tests/test_system.py), the first mode's damping ratio of the step map
+apart: tests/simulation/test_system.py), the first mode's damping ratio of the step map
 (mjeap.model.modes.first_mode_damping: the catalog's 0.05), and rollout's own bounds."""
 import mujoco
 import numpy as np

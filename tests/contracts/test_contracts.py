@@ -20,7 +20,7 @@ from mjeap.simulation.system import System, attach
 import mjeap.sweep
 from mjeap.sweep import grid, read_results, run_sweep
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 #: the sweep's point limit (read so: the module imports where the limit is missing)
 MAX_POINTS = getattr(mjeap.sweep, "MAX_POINTS", 1_000_000)
 

@@ -16,7 +16,7 @@ import pytest
 from mjeap.analysis.stability import MAP_BASE, column_limits, simulated_edges
 from mjeap.sweep import read_results, run_sweep
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 
 def test_theory_limits_are_ordered_and_match_the_closed_forms():

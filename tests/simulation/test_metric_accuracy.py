@@ -13,7 +13,7 @@ from mjeap.errors import ParameterError
 from mjeap.simulation.metric_accuracy import check_metrics, relaxed_step_cap, run_from_states
 from mjeap.engines.frame import to_waveform
 
-GOLDEN = Path(__file__).parent / "golden" / "metric_accuracy.json"
+GOLDEN = Path(__file__).resolve().parents[1] / "golden" / "metric_accuracy.json"
 MAP_SCENE = dict(orientation="up", payload="70mg@6.27mm")
 
 
@@ -192,7 +192,7 @@ def test_claim_on_a_geometry_sweep_of_a_file_actuator():
     point's true error below its target, its estimate within 3 x of it."""
     from mjeap.validation.metric_claim import check_geometry, summarise
     golden = json.loads(GOLDEN.with_name("metric_accuracy_geometry.json").read_text())
-    root = Path(__file__).resolve().parents[1]
+    root = Path(__file__).resolve().parents[2]
     rows = [r for t in golden["targets"] for r in check_geometry(golden, root, t)]
     s = summarise(rows)
     assert s["below_target"] == 1.0, s

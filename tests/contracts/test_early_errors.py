@@ -20,7 +20,7 @@ from mjeap.cli import main
 from mjeap.sweep import grid, run_sweep
 from mjeap.simulation.system import System, attach
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 
 
 #: the modules behind the scripts' command lines (the scripts themselves are thin)

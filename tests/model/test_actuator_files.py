@@ -37,7 +37,7 @@ from mjeap.errors import ParameterError, UnknownNameError
 from mjeap.model.catalog import CATALOG, CATALOG_DIR, get_actuator
 from mjeap.model.materials import RangeWarning
 
-GOLDEN = json.loads((Path(__file__).parent / "golden" / "catalog_eaac59e.json").read_text())["actuators"]
+GOLDEN = json.loads((Path(__file__).resolve().parents[1] / "golden" / "catalog_eaac59e.json").read_text())["actuators"]
 
 
 # ---------------------------------------------------------------- the catalog as files
@@ -88,7 +88,7 @@ def test_a_name_that_is_also_a_file_here_is_refused_naming_both(tmp_path, monkey
 
 # ---------------------------------------------------------------- files of our own
 #: a uniform PZT-5H bimorph, 12 x 3 mm: examples/actuators/uniform-bimorph.toml
-BIMORPH = (Path(__file__).resolve().parents[1] / "examples" / "actuators" / "uniform-bimorph.toml").read_text()
+BIMORPH = (Path(__file__).resolve().parents[2] / "examples" / "actuators" / "uniform-bimorph.toml").read_text()
 
 
 def _file(tmp_path, text, name="a.toml"):

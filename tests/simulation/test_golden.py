@@ -18,7 +18,7 @@ from mjeap.simulation.rollout import rollout
 from mjeap.simulation.scene import Scene
 from mjeap.validation import golden
 
-FOLDER = Path(__file__).parent / "golden"
+FOLDER = Path(__file__).resolve().parents[1] / "golden"
 
 
 @pytest.mark.parametrize("actuator_id", list(golden.SCENARIOS))

@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 README = (ROOT / "README.md").read_text()
 CI = (ROOT / ".ci" / "run").read_text()
 TEST_COMMAND = 'python -m pytest -q -m "not slow"'
@@ -77,13 +77,16 @@ def test_every_page_in_the_nav_exists():
 
 
 def test_every_test_file_has_a_layer(request):
-    from conftest import LAYERS
-    files = sorted(p.stem for p in (ROOT / "tests").glob("test_*.py"))
-    unassigned = [f for f in files if f not in LAYERS]
-    assert not unassigned, (f"{unassigned}: give each a layer in tests/conftest.py's LAYERS and in "
-                            "docs/testing.md's table")
+    """Every test file sits in a layer's folder (its marker comes from there), and every
+    layer has its row in docs/testing.md's table."""
+    from conftest import LAYERS, layer_of
+    files = sorted((ROOT / "tests").rglob("test_*.py"))
+    unassigned = [str(f.relative_to(ROOT)) for f in files if layer_of(f) is None]
+    assert not unassigned, f"{unassigned}: put each in one of the layer folders tests/{{{','.join(LAYERS)}}}/"
+    folders = sorted(p.name for p in (ROOT / "tests").iterdir() if p.is_dir() and any(p.glob("test_*.py")))
+    assert sorted(LAYERS) == folders, "tests/conftest.py's LAYERS and the test folders differ"
     table = (ROOT / "docs" / "testing.md").read_text()
-    missing = [f for f in files if f"`{f}.py`" not in table]
+    missing = [layer for layer in LAYERS if f"`tests/{layer}/`" not in table]
     assert not missing, f"{missing} not in docs/testing.md's table"
 
 

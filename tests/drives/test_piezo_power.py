@@ -20,7 +20,7 @@ from mjeap import Scene, rollout
 from mjeap.analysis.frequency import driven_power
 from mjeap.drives import make_drive
 
-GOLDEN = json.loads((Path(__file__).parent / "golden" / "piezo_power.json").read_text())
+GOLDEN = json.loads((Path(__file__).resolve().parents[1] / "golden" / "piezo_power.json").read_text())
 CASES = GOLDEN["cases"]
 #: the issue's bounds off resonance (r <= 0.5, r >= 1.5): power 2 %, lag 0.1 deg or 2 % of it
 POWER_TOL, LAG_TOL_DEG, LAG_TOL_REL = 0.02, 0.1, 0.02

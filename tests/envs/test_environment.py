@@ -17,7 +17,7 @@ from mjeap.envs.environment import make_environment, run_episode
 from mjeap.io.recording import read_recording
 from mjeap.versions import dm_control_problem
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 #: every test below runs on each backend: dm_env everywhere, dm_control where its Physics loads
 BACKENDS = ["dm_env", pytest.param("dm_control", marks=pytest.mark.dm_control)]
 

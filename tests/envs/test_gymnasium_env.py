@@ -112,7 +112,7 @@ def test_the_gymnasium_entry_point():
     import tomllib
     from importlib import metadata
     from pathlib import Path
-    project = tomllib.loads((Path(__file__).resolve().parent.parent / "pyproject.toml").read_text())["project"]
+    project = tomllib.loads((Path(__file__).resolve().parents[2] / "pyproject.toml").read_text())["project"]
     assert project["entry-points"]["gymnasium.envs"] == {"mjeap": "mjeap.envs.registration:register_envs"}
     installed = [e for e in metadata.entry_points(group="gymnasium.envs") if e.name == "mjeap"]
     for e in installed:

@@ -40,7 +40,7 @@ from mjeap.model.catalog import CATALOG
 from mjeap.model.materials import RangeWarning
 
 #: a uniform PZT-5H bimorph, 12 x 3 mm (its closed forms are written in these tests)
-BIMORPH = (Path(__file__).resolve().parents[1] / "examples" / "actuators" / "uniform-bimorph.toml").read_text()
+BIMORPH = (Path(__file__).resolve().parents[2] / "examples" / "actuators" / "uniform-bimorph.toml").read_text()
 E_P, E_CF, RHO_P, RHO_CF, T_P, T_CF, W, F31 = 40e9, 340e9, 7500.0, 1550.0, 127e-6, 60e-6, 3e-3, 32.0
 
 

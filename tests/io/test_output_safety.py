@@ -23,7 +23,7 @@ from mjeap.cli import main
 from mjeap.errors import ParameterError
 from mjeap.io.recording import read_recording
 
-ENV = {**os.environ, "PYTHONPATH": os.pathsep.join([os.path.dirname(os.path.dirname(__file__)),
+ENV = {**os.environ, "PYTHONPATH": os.pathsep.join([os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
                                                      os.environ.get("PYTHONPATH", "")])}
 
 # each child prints 'ready' once its loop has taken a few steps, then runs for minutes

@@ -1,7 +1,7 @@
 """The rod representation (mjeap.rod, a 1D flexcomp rod: MuJoCo 4.x) against the same
 analytical references as the hinge chain, within the hinge chain's tolerances (the checks
-the two share are parametrised with the rod where they live: tests/test_statics.py,
-tests/test_dynamics.py), and against the hinge chain on seed 000's heaviest run; what it
+the two share are parametrised with the rod where they live: tests/model/test_statics.py,
+tests/model/test_dynamics.py), and against the hinge chain on seed 000's heaviest run; what it
 refuses, and why.
 
 The PEDOT beam at the default 20 segments unless said otherwise. The rod is refused on
@@ -40,9 +40,9 @@ def test_rod_runs_under_discrete_with_its_own_damping(rod):
 
 
 # ---------------------------------------------------------------------------- statics
-# (the tip force to P L^2/EI = 3, the tip couple and the convergence order: tests/test_statics.py,
+# (the tip force to P L^2/EI = 3, the tip couple and the convergence order: tests/model/test_statics.py,
 # parametrised with the rod; f1 with tip masses and the free vibration's damping ratio:
-# tests/test_dynamics.py)
+# tests/model/test_dynamics.py)
 ALPHA_10_ROD_20 = pytest.mark.xfail(strict=True, reason=(
     "the rod at 20 segments is 0.20 % of L off axially and 0.21 % laterally at P L^2/EI = 10 (the hinge chain: "
     "0.022 % and 0.099 %): MuJoCo's discrete elastic rod measures the turn at a vertex as 2 tan(theta / 2), "
@@ -70,7 +70,7 @@ def test_buckling_load_within_1_percent():
     """Standing up under a tip payload: the modal analysis (in the hinge angles, gravity's
     geometric stiffness from the vertices' lever arms) calls the column straight at 0.99 x
     the critical load of the column with its own weight (scipy shooting) and buckled at
-    1.01 x; pushed, it returns at 0.97 x (tests/test_axial.py's check) and, run to rest,
+    1.01 x; pushed, it returns at 0.97 x (tests/model/test_axial.py's check) and, run to rest,
     settles on the post-buckled elastica at 1.03 x and 1.1 x (tip within 3 % of the
     elliptic-integral solution; measured -0.7 % and -1.2 %, the hinge chain +0.7 % and
     +0.1 %)."""

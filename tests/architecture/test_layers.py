@@ -15,7 +15,7 @@ import re
 import tomllib
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 #: the floors, bottom up: (name, the modules or packages on it); ``mjeap`` alone is its top level
 FLOORS = [
     ("foundation", ("mjeap.errors", "mjeap.units", "mjeap.versions", "mjeap.caching")),
@@ -254,7 +254,7 @@ def test_each_robot_is_its_model_and_its_experiments():
 
 
 def test_no_test_imports_a_script_by_path():
-    offenders = [p.name for p in (ROOT / "tests").glob("*.py")
+    offenders = [p.name for p in (ROOT / "tests").rglob("*.py")
                  if p.name != Path(__file__).name and "spec_from_file_location" in p.read_text()]
     assert not offenders
 

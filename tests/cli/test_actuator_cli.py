@@ -29,7 +29,7 @@ from mjeap.cli import main
 from mjeap.errors import ParameterError
 from mjeap.model.catalog import CATALOG_DIR
 
-ROOT = Path(__file__).resolve().parent.parent
+ROOT = Path(__file__).resolve().parents[2]
 EXAMPLES = ROOT / "examples" / "actuators"
 BIMORPH, TRILAYER = EXAMPLES / "long-bimorph.toml", EXAMPLES / "thick-trilayer.toml"
 
