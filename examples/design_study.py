@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 import mjeap
-from mjeap.sweep import grid, read_results, run_sweep
+from mjeap.studies.sweep import grid, read_results, run_sweep
 
 HERE = Path(__file__).resolve().parent
 ACTUATOR = HERE / "actuators" / "long-bimorph.toml"

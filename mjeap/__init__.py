@@ -31,8 +31,46 @@ __all__ = ["CATALOG", "Actuator", "Layer", "Planform", "get_actuator", "actuator
            "UnitSystem", "analytical", "DRIVES", "Drive", "register_drive", "RolloutResult", "free_vibration", "rollout", "rollout_batch",
            "Waveform", "parse_waveform", "System", "attach"]
 
-from .optimize import optimize  # noqa: E402  (design optimisation, mjeap.optimize)
+from .studies.optimize import optimize  # noqa: E402  (design optimisation: the module is mjeap.studies.optimize)
 __all__.append("optimize")
+
+import importlib as _importlib  # noqa: E402
+import importlib.abc as _abc  # noqa: E402
+import sys as _sys  # noqa: E402
+
+#: the modules that moved, importable under their earlier names (documented aliases, the same
+#: module objects): ``import mjeap.sweep`` is ``mjeap.studies.sweep``, ``mjeap.design`` is
+#: ``mjeap.model.variants`` (the earlier ``mjeap.sweep.design`` is ``mjeap.studies.sweep.points``)
+ALIASES = {"mjeap.sweep.design": "mjeap.studies.sweep.points", "mjeap.sweep": "mjeap.studies.sweep",
+           "mjeap.design": "mjeap.model.variants"}
+
+
+class _AliasLoader(_abc.Loader):
+    """Imports an alias as the module it names (the same object, under both names)."""
+
+    def create_module(self, spec):
+        module = _importlib.import_module(ALIASES.get(spec.name) or
+                                          ALIASES["mjeap.sweep"] + spec.name[len("mjeap.sweep"):])
+        spec.loader_state = module.__spec__         # the import sets the alias's spec on it: put back below
+        return module
+
+    def exec_module(self, module):
+        own = module.__spec__.loader_state
+        module.__spec__, module.__loader__ = own, own.loader
+
+
+class _AliasFinder(_abc.MetaPathFinder):
+    """Finds the names of :data:`ALIASES` (and their submodules)."""
+
+    def find_spec(self, fullname, path=None, target=None):
+        if fullname in ALIASES or fullname.startswith("mjeap.sweep."):
+            from importlib.machinery import ModuleSpec
+            return ModuleSpec(fullname, _AliasLoader())
+        return None
+
+
+if not any(isinstance(f, _AliasFinder) for f in _sys.meta_path):
+    _sys.meta_path.insert(0, _AliasFinder())
 
 import importlib.util as _util  # noqa: E402
 

@@ -426,8 +426,8 @@ def _value(text: str):
 def _sweep_values(spec: str, random: bool, actuator=None):
     """NAME=a,b,c (list) | NAME=lo:hi:n (n values, linspace) | NAME=lo..hi (random range);
     values SI or with the parameter's unit (``actuator.length=8mm:16mm:5``,
-    :func:`mjeap.design.to_value`; ``actuator`` resolves drive.NAME's units)."""
-    from .design import to_value
+    :func:`mjeap.studies.parameters.to_value`; ``actuator`` resolves drive.NAME's units)."""
+    from .studies.parameters import to_value
     name, sep, rhs = spec.partition("=")
     if not sep or not rhs:
         raise ParameterError("--vary", spec, "NAME=a,b,c or NAME=lo:hi:n (grid) or NAME=lo..hi (with --random)")
@@ -444,7 +444,7 @@ def _sweep_values(spec: str, random: bool, actuator=None):
             lo, hi, n = rhs.split(":")
             if int(n) < 1:
                 raise ValueError("n < 1")
-            from .sweep import check_design_size       # the count, checked before the values are made
+            from .studies.sweep import check_design_size       # the count, checked before the values are made
             check_design_size(int(n), "--vary", f"{spec}: {int(n):,} values of {name}")
             return name, [float(x) for x in np.linspace(num(lo), num(hi), int(n))]
     except ValueError as e:
@@ -455,8 +455,8 @@ def _sweep_values(spec: str, random: bool, actuator=None):
 
 
 def cmd_sweep(args) -> int:
-    from . import sweep
-    from .design import to_value
+    from .studies import sweep
+    from .studies.parameters import to_value
     raw = dict(kv.partition("=")[::2] for kv in (args.set or []))
     actuator = raw.get("actuator", sweep.PARAMETERS["actuator"])
     values = dict(_sweep_values(v, args.random is not None, actuator) for v in (args.vary or []))
@@ -495,8 +495,8 @@ def cmd_sweep(args) -> int:
 
 
 def cmd_optimize(args) -> int:
-    from .optimize import optimize
-    from .design import to_value
+    from .studies.optimize import optimize
+    from .studies.parameters import to_value
     vary = {}
     for spec in args.vary or []:
         name, sep, rhs = spec.partition("=")
@@ -629,7 +629,7 @@ def build_parser() -> argparse.ArgumentParser:
                         "first_frequency, mass, free_deflection, blocked_force, energy_density, peak_power, "
                         "energy_per_cycle")
     p.add_argument("--out", default="out/sweep.csv", help="results CSV (appended; finished points are skipped)")
-    from .sweep import EXECUTORS
+    from .studies.sweep import EXECUTORS
     p.add_argument("--executor", choices=EXECUTORS, default="processes")
     p.add_argument("--workers", type=int, default=2, help="worker processes (local pool or Dask LocalCluster)")
     p.add_argument("--scheduler", help="Dask scheduler address (tcp://host:8786); default: a LocalCluster")
@@ -653,7 +653,7 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--set", action="append", metavar="NAME=VALUE",
                    help="a fixed sweep setting (segments, orientation, payload_mass, ...; repeatable)")
     p.add_argument("--metrics", help="more metrics to record at every evaluation (comma list)")
-    from .optimize import METHODS
+    from .studies.optimize import METHODS
     p.add_argument("--method", choices=METHODS, default="slsqp",
                    help="slsqp (local, from the box's centre and --starts - 1 seeded points; default) or "
                         "differential-evolution (global, then polished by SLSQP)")

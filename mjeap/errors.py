@@ -103,7 +103,7 @@ class sigterm_as_interrupt:
     """Context manager: within it (in the main thread) SIGTERM raises :class:`Terminated`,
     a KeyboardInterrupt, so a run or a sweep ends as after Ctrl-C; the previous handler is
     restored on exit. Elsewhere (another thread, or a pool worker whose parent stops it:
-    ``in_pool_worker``, set by :func:`mjeap.sweep.worker_signals`) it does nothing: a
+    ``in_pool_worker``, set by :func:`mjeap.studies.sweep.worker_signals`) it does nothing: a
     worker asked to stop by its parent stops at once, it does not finish its point (nor
     hold its task queue's lock while the parent waits for it)."""
 

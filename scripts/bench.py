@@ -373,7 +373,7 @@ def bench_sweep(points=16, duration=2.0):
     import tempfile
     import tracemalloc
     from mjeap import rollout
-    from mjeap.sweep import grid, run_sweep
+    from mjeap.studies.sweep import grid, run_sweep
     pts = grid(payload_mass=list(np.linspace(1e-6, 12.6e-6, points // 2)), amplitude=[0.5, 1.0])
     base = {"actuator": "pedot-micro", "orientation": "up", "waveform": "square", "frequency": 0.5,
             "duration": duration, "payload_position": 6.27e-3}
@@ -402,8 +402,8 @@ def bench_sweep(points=16, duration=2.0):
 def bench_native(repeats=2, map_points=8):
     from mjeap import Payload, rollout, rollout_batch
     from mjeap.drives import make_drive
-    from mjeap.analysis.stability import MAP_BASE
-    from mjeap.sweep import grid, run_sweep
+    from mjeap.studies.stability_map import MAP_BASE
+    from mjeap.studies.sweep import grid, run_sweep
     s = Scene("pedot-micro", orientation="up", payload=Payload(12.6e-6, 6.27e-3))
     args = dict(duration=20.0, initial_curvature=-303.0, progress=False)
     out = {"case": "pedot-micro, 12.6 mg @ 6.27 mm, up, square 3 Vpp 0.1 Hz, 20 s, from -303 1/m",
@@ -470,8 +470,8 @@ def bench_accuracy(claim_cases=12):
     from mjeap import rollout, rollout_batch
     from mjeap.simulation.accuracy import relative_difference
     from mjeap.drives import make_drive
-    from mjeap.analysis.stability import MAP_BASE
-    from mjeap.sweep import grid, read_results, run_sweep
+    from mjeap.studies.stability_map import MAP_BASE
+    from mjeap.studies.sweep import grid, read_results, run_sweep
     from mjeap.validation.accuracy_claim import check_case, draw_cases, summarise
     wave, args = "square:1.5V@0.1Hz", dict(initial_curvature=-303.0, progress=False)
     s = Scene("pedot-micro", orientation="up", payload="12.6mg@6.27mm")
@@ -536,9 +536,9 @@ def bench_metric_map(masses=(20, 40, 60, 70, 74, 78, 82, 100), amplitudes=(0.25,
     (``wide``: masses x amplitudes) on 2 workers, once each; and where the time of an
     accuracy point goes (its runs)."""
     import tempfile
-    from mjeap.analysis.stability import MAP_BASE, simulated_edges
+    from mjeap.studies.stability_map import MAP_BASE, simulated_edges
     from mjeap.simulation.scene import clear_build_caches
-    from mjeap.sweep import grid, read_results, run_sweep
+    from mjeap.studies.sweep import grid, read_results, run_sweep
     pts = grid(payload_mass=[m * 1e-6 for m in masses], amplitude=list(amplitudes))
     out = {"case": f"stability map points ({len(pts)}: {', '.join(map(str, masses))} mg x {amplitudes} V; the "
                    "relaxed column load 76 mg between 74 and 78), pedot-micro standing, 30 s, square 0.1 Hz",
@@ -614,8 +614,8 @@ def bench_early_stop(map_points=8):
     stop_when_periodic=1e-2 (mjeap.simulation.periodic), 2 workers: points per second, where
     each stopped, and the returns."""
     import tempfile
-    from mjeap.analysis.stability import MAP_BASE
-    from mjeap.sweep import grid, read_results, run_sweep
+    from mjeap.studies.stability_map import MAP_BASE
+    from mjeap.studies.sweep import grid, read_results, run_sweep
     pts = grid(payload_mass=list(np.linspace(15e-6, 120e-6, map_points // 2)), amplitude=[0.5, 1.5])
     out = {"case": f"stability map bench points ({len(pts)}), 2 workers, default model"}
     with tempfile.TemporaryDirectory() as d:
@@ -644,7 +644,7 @@ def bench_optimize(f_min=800.0, box=(5e-3, 15e-3), resolution=0.01):
     import math
     import tempfile
     import mjeap
-    from mjeap.sweep import grid, read_results, run_sweep
+    from mjeap.studies.sweep import grid, read_results, run_sweep
     # the closed form: L* = beta_1 sqrt(1 / (2 pi f_min)) (EI / mu)^(1/4), EI and mu from the layers
     E, t, rho = np.array([40e9, 340e9, 40e9]), np.array([127e-6, 60e-6, 127e-6]), np.array([7500.0, 1550.0, 7500.0])
     z = np.cumsum(t) - t / 2
@@ -689,10 +689,10 @@ def bench_warp(map_points=4, duration=1.0, batch=16, batch_duration=0.6):
     amplitudes, and a small stability map (``map_points`` points of ``duration`` s, serial)."""
     import tempfile
     from mjeap import Payload, rollout_batch
-    from mjeap.analysis.stability import MAP_BASE
+    from mjeap.studies.stability_map import MAP_BASE
     from mjeap.drives import make_drive
     from mjeap.engines import get_engine
-    from mjeap.sweep import grid, run_sweep
+    from mjeap.studies.sweep import grid, run_sweep
     s = Scene("pedot-micro", orientation="up", payload=Payload(12.6e-6, 6.27e-3))
     why = get_engine("warp").why_not(s, make_drive(None, s))
     if why is not None:

@@ -13,7 +13,7 @@ stiffness, x 0.3/0.52), and the paper's own Region 3 model's marginal mass.
 import sys
 
 from mjeap.io.commandline import run_script
-from mjeap.stability_map import main
+from mjeap.studies.stability_map import main
 
 if __name__ == "__main__":
     sys.exit(run_script(main))

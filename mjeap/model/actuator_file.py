@@ -53,7 +53,7 @@ else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
 __all__ = ["read_actuator", "write_actuator", "actuator_toml", "is_actuator_file", "TOP_KEYS", "PLANFORM_KEYS",
-           "LAYER_KEYS", "DriveInfo", "set_drive_info"]
+           "LAYER_KEYS", "DriveInfo", "set_drive_info", "drive_info"]
 
 
 class DriveInfo:
@@ -68,6 +68,11 @@ class DriveInfo:
 
 
 _drive_info: Optional[DriveInfo] = None
+
+
+def drive_info() -> Optional[DriveInfo]:
+    """The drive layer's answers (:class:`DriveInfo`), None before mjeap.drives installed them."""
+    return _drive_info
 
 
 def set_drive_info(info: DriveInfo) -> None:

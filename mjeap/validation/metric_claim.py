@@ -149,7 +149,7 @@ GEOMETRY = {"actuator": "examples/actuators/thick-trilayer.toml", "lengths_m": (
 def geometry_goldens(root) -> dict:
     """The converged peak_to_peak of :data:`GEOMETRY`'s lengths (``root``: the repository,
     where the actuator file lies)."""
-    from ..design import design_actuator
+    from ..model.variants import design_actuator
     g = GEOMETRY
     path = str(root / g["actuator"])
     wave = f"{g['waveform']}:{g['amplitude']!r}V@{g['frequency']!r}Hz"
@@ -162,11 +162,11 @@ def geometry_goldens(root) -> dict:
 
 
 def check_geometry(golden: dict, root, target: float, executor: str = "serial") -> dict:
-    """The geometry sweep run by :func:`mjeap.sweep.run_sweep` at ``target`` on its metrics,
+    """The geometry sweep run by :func:`mjeap.studies.sweep.run_sweep` at ``target`` on its metrics,
     each point against its converged value (relative to the converged run's scale)."""
     import tempfile
     from pathlib import Path
-    from ..sweep import grid, read_results, run_sweep
+    from ..studies.sweep import grid, read_results, run_sweep
     base = {"actuator": str(root / golden["actuator"]), "waveform": golden["waveform"],
             "amplitude": golden["amplitude"], "frequency": golden["frequency"], "duration": golden["duration"],
             "accuracy": target}

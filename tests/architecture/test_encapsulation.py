@@ -60,7 +60,7 @@ def _module_names(tree) -> set:
 
 #: by-name accesses (``getattr(x, "_name")``) allowed, (file, name): a library's private
 #: state that has no public way in
-LIBRARY_PRIVATE = {("mjeap/sweep/runner.py", "_processes")}     # concurrent.futures' worker processes
+LIBRARY_PRIVATE = {("mjeap/studies/sweep/runner.py", "_processes")}     # concurrent.futures' worker processes
 
 
 def _by_name(node, own_attrs: set):

@@ -5,7 +5,7 @@ round a circle, lazy imports and ``importlib.import_module`` strings included), 
 has a floor, no test imports a script by path, and only ``mjeap`` is installed at the top.
 
 Floors, bottom up: the foundation (errors, units, versions), io, model, drives, engines,
-simulation, analysis; then the applications: controllers, the studies (mjeap.design, the
+simulation, analysis; then the applications: controllers, the studies (mjeap.studies: the
 sweep package, optimize, the stability map), robots (a package each: model, experiments),
 envs (the dm_env and Gymnasium environments: the tracking task and the robots as tasks, so
 above the robots), validation (and the MJCF assets), cli, and last the package's top level
@@ -26,7 +26,7 @@ FLOORS = [
     ("simulation", ("mjeap.simulation",)),
     ("analysis", ("mjeap.analysis",)),
     ("controllers", ("mjeap.controllers",)),
-    ("studies", ("mjeap.design", "mjeap.sweep", "mjeap.optimize", "mjeap.stability_map")),
+    ("studies", ("mjeap.studies",)),
     ("robots", ("mjeap.robots",)),
     ("envs", ("mjeap.envs",)),
     ("validation", ("mjeap.validation", "mjeap.assets")),
@@ -211,9 +211,9 @@ def test_the_graph_follows_import_module_strings():
     robots' registry imports every robot package, and a circle through it is found."""
     path = MODULES["mjeap.robots"]
     source = ('import importlib\nimportlib.import_module("mjeap.cli")\n'
-              'importlib.import_module(".sweep", "mjeap")\nimportlib.import_module(f"{__name__}.{m}")\n')
+              'importlib.import_module(".studies.sweep", "mjeap")\nimportlib.import_module(f"{__name__}.{m}")\n')
     found = set(_imports("mjeap.robots", path, source))
-    assert {"mjeap.cli", "mjeap.sweep", "mjeap.robots.gripper", "mjeap.robots.registry"} <= found
+    assert {"mjeap.cli", "mjeap.studies.sweep", "mjeap.robots.gripper", "mjeap.robots.registry"} <= found
     assert not any(m.startswith("mjeap.robots.gripper.") for m in found)      # one name per field
     assert {"mjeap.robots.gripper", "mjeap.robots.hamr_walk"} <= set(GRAPH["mjeap.robots"])
     assert _circles({**GRAPH, "mjeap.robots.gripper.experiments": ["mjeap.cli"]})
@@ -226,7 +226,7 @@ def test_the_graph_sees_the_layers():
     assert "mjeap.simulation.scene" in GRAPH["mjeap.simulation.rollout"]
     assert "mjeap.robots" in GRAPH["mjeap.cli"] and "mjeap.io.commandline" in GRAPH["mjeap.robots.hamr_leg.experiments"]
     order = [layer(m) for m in ("mjeap.engines.loop", "mjeap.simulation.system", "mjeap.analysis.frequency",
-                                "mjeap.controllers.hamr_leg", "mjeap.sweep.runner", "mjeap.robots.hamr_leg.model",
+                                "mjeap.controllers.hamr_leg", "mjeap.studies.sweep.runner", "mjeap.robots.hamr_leg.model",
                                 "mjeap.envs.gymnasium_env", "mjeap.validation.core", "mjeap.cli", "mjeap")]
     assert "mjeap.robots.hamr_walk.model" in GRAPH["mjeap.envs.hamr_walk"]      # a robot as a task
     assert order == sorted(order) and len(set(order)) == len(order)
@@ -285,3 +285,16 @@ def test_scenes_systems_and_environments_pick_their_engine_in_one_registry():
     assert r.meta["engine"] == "loop" and "not native" in r.meta["engine_reason"]
     assert engines.stepper().name == "loop"
     assert "System" in engines.get_engine("threaded").system_reason(wing)
+
+
+def test_moved_modules_import_under_their_earlier_names():
+    """The documented aliases of modules that moved (issue 44): the same module objects,
+    each keeping its own name and spec (pickling and reloading see the real module)."""
+    import importlib
+    import mjeap
+    for old, new in mjeap.ALIASES.items():
+        a, b = importlib.import_module(old), importlib.import_module(new)
+        assert a is b and b.__name__ == new and b.__spec__.name == new
+    from mjeap.sweep import run_sweep
+    from mjeap.studies.sweep import run_sweep as real
+    assert run_sweep is real and callable(mjeap.optimize)

@@ -17,12 +17,12 @@ import pytest
 from mjeap import ParameterError, Scene, rollout
 from mjeap.cli import main
 from mjeap.simulation.system import System, attach
-import mjeap.sweep
-from mjeap.sweep import grid, read_results, run_sweep
+import mjeap.studies.sweep
+from mjeap.studies.sweep import grid, read_results, run_sweep
 
 ROOT = Path(__file__).resolve().parents[2]
 #: the sweep's point limit (read so: the module imports where the limit is missing)
-MAX_POINTS = getattr(mjeap.sweep, "MAX_POINTS", 1_000_000)
+MAX_POINTS = getattr(mjeap.studies.sweep, "MAX_POINTS", 1_000_000)
 
 
 def _no_work(*a, **k):
@@ -130,7 +130,7 @@ def test_a_design_beyond_the_point_limit_is_refused_before_it_is_built(monkeypat
     from the spec's arithmetic, naming it and MAX_POINTS; a grid whose product is too large
     and a random design too."""
     import mjeap.cli as cli
-    import mjeap.sweep as sweep
+    import mjeap.studies.sweep as sweep
     monkeypatch.setattr(cli.np, "linspace", _no_work)
     monkeypatch.setattr(sweep, "run_sweep", _no_work)
     assert main(["sweep", "--vary", "amplitude=0:1:1000000000", "--out", str(tmp_path / "s.csv")]) == 2

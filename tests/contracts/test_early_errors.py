@@ -17,7 +17,7 @@ import pytest
 
 from mjeap import ParameterError, Scene, rollout, rollout_batch
 from mjeap.cli import main
-from mjeap.sweep import grid, run_sweep
+from mjeap.studies.sweep import grid, run_sweep
 from mjeap.simulation.system import System, attach
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -25,7 +25,7 @@ ROOT = Path(__file__).resolve().parents[2]
 
 #: the modules behind the scripts' command lines (the scripts themselves are thin)
 SCRIPT_MODULES = {"hamr_leg": "mjeap.robots.hamr_leg.experiments", "robobee_wing": "mjeap.robots.robobee_wing.experiments",
-                  "gripper": "mjeap.robots.gripper.experiments", "stability_map": "mjeap.stability_map",
+                  "gripper": "mjeap.robots.gripper.experiments", "stability_map": "mjeap.studies.stability_map",
                   "env_episode": "mjeap.envs.environment"}
 
 

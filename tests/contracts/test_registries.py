@@ -19,7 +19,7 @@ from mjeap.model.mjcf import BUILDERS, HingeChainBuilder
 from mjeap.robots import Robot
 from mjeap.robots.registry import _REGISTRY as ROBOTS
 from mjeap.simulation.system import System, attach
-from mjeap.sweep import METRICS, evaluate, register_metric
+from mjeap.studies.sweep import METRICS, evaluate, register_metric
 
 
 @pytest.fixture(autouse=True)

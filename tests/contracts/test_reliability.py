@@ -9,7 +9,7 @@ import pytest
 
 from mjeap.cli import main
 from mjeap.errors import UnknownNameError
-from mjeap.sweep import grid, read_results, run_sweep
+from mjeap.studies.sweep import grid, read_results, run_sweep
 
 POINTS = grid(amplitude=[0.5, 1.0])
 
@@ -249,7 +249,7 @@ def _killer_metric(r, point, scene):
 
 
 def test_a_killed_worker_fails_its_point_and_the_sweep_goes_on(tmp_path):
-    from mjeap.sweep import METRICS, register_metric
+    from mjeap.studies.sweep import METRICS, register_metric
     register_metric("killer", _killer_metric)
     try:
         pts = grid(amplitude=[0.5, 0.7, 1.0, 1.2])
@@ -295,7 +295,7 @@ def test_stopping_a_sweep_stops_its_workers_and_keeps_its_rows(tmp_path, how):
     pids = tmp_path / "pids"
     pids.mkdir()
     code = ("import os, sys, time\n"
-            "from mjeap.sweep import grid, run_sweep, register_metric\n"
+            "from mjeap.studies.sweep import grid, run_sweep, register_metric\n"
             "def slow(r, p, s):\n"
             "    open(os.path.join(sys.argv[2], str(os.getpid())), 'w').close()\n"
             "    time.sleep(0.3 if p['amplitude'] < 0.6 else 60)\n"

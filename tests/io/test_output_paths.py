@@ -229,7 +229,7 @@ def test_a_really_full_disk_keeps_the_old_outputs_and_a_sweep_its_whole_rows(tmp
 
 
 def test_a_sweep_that_fills_the_disk_stops_with_its_rows_whole(tmp_path, monkeypatch):
-    from mjeap.sweep import grid, read_results, run_sweep
+    from mjeap.studies.sweep import grid, read_results, run_sweep
     out = tmp_path / "s.csv"
     real, state = os.write, {"rows": 0}
 

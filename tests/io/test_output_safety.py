@@ -203,7 +203,7 @@ def test_a_lock_left_by_a_killed_writer_blocks_nothing(tmp_path):
 
 # ---------------------------------------------------------------- 3. spreadsheet-safe CSVs
 def test_csv_cells_a_spreadsheet_would_run_are_neutralised_and_read_back(tmp_path, capsys):
-    from mjeap.sweep import read_results
+    from mjeap.studies.sweep import read_results
     out = tmp_path / "s.csv"
     args = ["sweep", "--vary", "actuator=pedot-micro,=1+1", "--vary", "amplitude=-0.5,0.5", "--set",
             "duration=0.02", "--executor", "serial", "--quiet", "--out", str(out)]

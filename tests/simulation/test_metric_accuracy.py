@@ -98,8 +98,8 @@ def test_a_map_row_reports_the_extrapolated_answer(tmp_path):
     """A sweep at a target on its metrics writes the values the accuracy report gives (the
     extrapolated peak-to-peak and the returns decided on the extrapolated margin), not those
     read from the recorded run."""
-    from mjeap.analysis.stability import MAP_BASE
-    from mjeap.sweep.runner import evaluate
+    from mjeap.studies.stability_map import MAP_BASE
+    from mjeap.studies.sweep.runner import evaluate
     point = {"payload_mass": 70e-6, "amplitude": 1.5}
     row = evaluate(point, ("returns", "peak_to_peak"), {**MAP_BASE, "accuracy": 1e-2})
     from mjeap.model.discretize import Payload

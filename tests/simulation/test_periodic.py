@@ -107,7 +107,7 @@ def test_a_stop_that_cannot_work_is_refused_before_any_run(wave, duration, kw, n
 
 
 def test_a_sweep_row_says_where_its_point_stopped(tmp_path):
-    from mjeap.sweep import read_results, run_sweep
+    from mjeap.studies.sweep import read_results, run_sweep
     base = dict(actuator="pedot-micro", segments=8, waveform="square", frequency=0.5, duration=16.0,
                 stop_when_periodic=1e-2)
     run_sweep([dict(amplitude=1.0)], tmp_path / "s.csv", metrics=("returns", "stopped_early"), base=base,
@@ -130,7 +130,7 @@ def test_the_threaded_engine_stops_too():
 
 
 def test_a_sweep_refuses_a_stop_its_points_cannot_make_once_before_any_point(tmp_path):
-    from mjeap.sweep import run_sweep
+    from mjeap.studies.sweep import run_sweep
     base = dict(actuator="pedot-micro", segments=8, waveform="square", frequency=0.5, stop_when_periodic=1e-2)
     with pytest.raises(ParameterError, match="stop_when_periodic"):       # duration 2 / f: two periods
         run_sweep([dict(amplitude=1.0)], tmp_path / "s.csv", base=base, executor="serial", progress=False)

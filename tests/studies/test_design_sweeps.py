@@ -1,5 +1,5 @@
 """Geometry and materials in studies (own-actuator issue, deliverable 3): ``actuator.X``
-sweep parameters build each point's actuator from the base file (mjeap.design), and the
+sweep parameters build each point's actuator from the base file (mjeap.model.variants), and the
 designers' metrics against references derived here from the file's layer stack, not from
 mjeap's code.
 
@@ -33,7 +33,9 @@ import pytest
 from pathlib import Path
 from scipy import optimize as so
 
-from mjeap import design, rollout, sweep
+from mjeap import rollout
+from mjeap.model import variants as design
+from mjeap.studies import sweep
 from mjeap.cli import main
 from mjeap.errors import ParameterError, UnknownNameError
 from mjeap.model.catalog import CATALOG

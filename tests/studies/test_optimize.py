@@ -24,7 +24,8 @@ import numpy as np
 import pytest
 
 import mjeap
-from mjeap import Actuator, sweep
+from mjeap import Actuator
+from mjeap.studies import sweep
 from mjeap.cli import main
 from mjeap.errors import ParameterError, UnknownNameError
 

@@ -1,4 +1,4 @@
-"""The stability map of seed 000's inverted actuator (mjeap.stability_map, mjeap.analysis.stability, scripts/stability_map.py).
+"""The stability map of seed 000's inverted actuator (mjeap.studies.stability_map, mjeap.studies.stability_map, scripts/stability_map.py).
 
 Physics claim: the simulated payload limit sits at the static column load with the relaxed
 EI (76 mg at l_e = 6.27 mm), not at the paper's Region 3 model (46 mg) or the instantaneous
@@ -13,8 +13,8 @@ from pathlib import Path
 
 import pytest
 
-from mjeap.analysis.stability import MAP_BASE, column_limits, simulated_edges
-from mjeap.sweep import read_results, run_sweep
+from mjeap.studies.stability_map import MAP_BASE, column_limits, simulated_edges
+from mjeap.studies.sweep import read_results, run_sweep
 
 ROOT = Path(__file__).resolve().parents[2]
 

@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from mjeap.errors import ParameterError, UnknownNameError
-from mjeap.sweep import evaluate, grid, point_id, random_design, read_results, run_sweep
+from mjeap.studies.sweep import evaluate, grid, point_id, random_design, read_results, run_sweep
 
 #: cheap points: the unloaded PEDOT actuator, two 1 Hz periods
 BASE = dict(actuator="pedot-micro", frequency=1.0, duration=2.0)
@@ -84,8 +84,8 @@ def test_at_a_target_a_family_shares_its_first_points_error_model(tmp_path, monk
     family (no pilots to share). Each point's estimated error is measured on it and
     meets the target, and its peak-to-peak agrees with pilots per point within what the two
     targets allow."""
-    import mjeap.sweep.runner as sw
-    from mjeap.sweep.runner import _family
+    import mjeap.studies.sweep.runner as sw
+    from mjeap.studies.sweep.runner import _family
     base = {"actuator": "pedot-micro", "orientation": "horizontal", "waveform": "sine", "frequency": 10.0,
             "duration": 0.2, "accuracy": 1e-3}
     pts = [{"amplitude": a} for a in (0.5, 1.0, 1.5)]

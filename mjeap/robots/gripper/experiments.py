@@ -38,7 +38,7 @@ from ...io.commandline import arg_number, arg_output, parse_args
 from ...io.outputs import replacing, run_guard
 from ...model.analytical import DadrasModel
 from ...simulation.system import System
-from ...sweep import stop_workers, worker_signals
+from ...studies.sweep import stop_workers, worker_signals
 from ..registry import summary
 from .model import A, BEAD_MASS, BEAD_RADIUS, G, GAP, MU, MU_TORSION, build
 

@@ -1,9 +1,9 @@
-"""Design optimisation: maximise or minimise one metric of :mod:`mjeap.sweep` over bounded
+"""Design optimisation: maximise or minimise one metric of :mod:`mjeap.studies.sweep` over bounded
 actuator, drive and payload parameters, subject to constraints on other metrics, with
 scipy's optimisers (``mjeap optimize``, :func:`optimize`).
 
-An evaluation is one sweep point (:func:`mjeap.sweep.evaluate`): a Scene of the point's
-actuator (:mod:`mjeap.design` builds it from the base actuator and the ``actuator.X``
+An evaluation is one sweep point (:func:`mjeap.studies.sweep.evaluate`): a Scene of the point's
+actuator (:mod:`mjeap.model.variants` builds it from the base actuator and the ``actuator.X``
 values) and, only where a metric needs one, a rollout; ``first_frequency`` and ``mass``
 read the linearised model alone. Every evaluation is appended to a CSV in the sweep's own
 format as it finishes; a rerun with the same CSV reads it as a cache (the same points get
@@ -39,7 +39,8 @@ from typing import Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 
-from .errors import MjeapError, ParameterError, UnknownNameError, check_integer, check_range, sigterm_as_interrupt
+from .parameters import to_value
+from ..errors import MjeapError, ParameterError, UnknownNameError, check_integer, check_range, sigterm_as_interrupt
 
 __all__ = ["optimize", "Constraint", "OptimizeResult", "parse_constraint", "parse_bounds", "METHODS"]
 
@@ -76,7 +77,7 @@ class Constraint:
 def parse_constraint(text: Union[str, Constraint, tuple]) -> Constraint:
     """``"NAME>=VALUE"`` or ``"NAME<=VALUE"`` (VALUE SI or with the metric's unit, e.g.
     ``first_frequency>=0.8kHz``), a (name, sense, value) tuple or a Constraint."""
-    from .model.quantity import to_si
+    from ..model.quantity import to_si
     from .sweep import METRIC_UNITS, METRICS
     if isinstance(text, Constraint):
         c = text
@@ -101,9 +102,9 @@ def parse_constraint(text: Union[str, Constraint, tuple]) -> Constraint:
 def parse_bounds(name: str, value, actuator=None) -> Tuple[float, float]:
     """(low, high) SI of a varied parameter from (low, high) numbers or texts with units, or
     text ``"LOW:HIGH"`` (``"5mm:15mm"``): low < high, both in the parameter's range
-    (:func:`mjeap.design.check_design_value` for actuator.X, the drive's RANGES for
+    (:func:`mjeap.variants.check_design_value` for actuator.X, the drive's RANGES for
     drive.NAME, :data:`VARIABLE` for the others). Raises ParameterError naming it."""
-    from . import design
+    from ..model import variants
     accepted = f"{name}=LOW:HIGH with LOW < HIGH (SI, or with a unit: 5mm:15mm)"
     if isinstance(value, str):
         parts = value.split(":")
@@ -114,19 +115,19 @@ def parse_bounds(name: str, value, actuator=None) -> Tuple[float, float]:
         lo, hi = value
     except (TypeError, ValueError):
         raise ParameterError("--vary", f"{name}={value!r}", accepted) from None
-    lo, hi = (design.to_value(name, v, actuator) for v in (lo, hi))
+    lo, hi = (to_value(name, v, actuator) for v in (lo, hi))
     for v in (lo, hi):
         if isinstance(v, str) or isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
             raise ParameterError("--vary", f"{name}={value!r}", accepted, f"{v!r} is not a finite number")
     lo, hi = float(lo), float(hi)
     if not lo < hi:
         raise ParameterError("--vary", f"{name}={lo:g}:{hi:g}", accepted)
-    if design.is_design_parameter(name):
+    if variants.is_design_parameter(name):
         for v in (lo, hi):
-            design.check_design_value(name, v, actuator)
+            variants.check_design_value(name, v, actuator)
     elif name.startswith("drive."):
-        from .drives import default_drive_name, get_drive_class
-        cls = get_drive_class(default_drive_name(design.get_base(actuator)))
+        from ..drives import default_drive_name, get_drive_class
+        cls = get_drive_class(default_drive_name(variants.get_base(actuator)))
         known = list(cls.parameter_units())
         if name[6:] not in known:
             raise UnknownNameError(f"{cls.name} drive parameter (drive.NAME)", name[6:], known)
@@ -142,7 +143,7 @@ def parse_bounds(name: str, value, actuator=None) -> Tuple[float, float]:
     else:
         raise UnknownNameError("optimisation parameter (--vary)", name,
                                [*VARIABLE, "actuator.NAME", "drive.NAME"] + (
-                                   design.design_parameter_names(actuator) if actuator is not None else []))
+                                   variants.design_parameter_names(actuator) if actuator is not None else []))
     return lo, hi
 
 
@@ -197,7 +198,7 @@ def _number(v) -> float:
 
 class _Evaluations:
     """The evaluations of one optimisation: points by their u in [0, 1]^n, each evaluated
-    once (:func:`mjeap.sweep.evaluate`, serial, in this process) or read from the CSV,
+    once (:func:`mjeap.studies.sweep.evaluate`, serial, in this process) or read from the CSV,
     appended to it as they finish."""
 
     def __init__(self, names, lo, hi, metrics, base, cached, out, columns, max_evaluations, bar,
@@ -292,7 +293,7 @@ class _Evaluations:
 
 def _readback(v):
     """A metric's value as the CSV gives it back (so a rerun from the cache is the same)."""
-    from .io.csvio import plain_cell
+    from ..io.csvio import plain_cell
     if isinstance(v, (float, np.floating)):
         return float(repr(float(v)))
     return plain_cell(v)
@@ -357,11 +358,11 @@ def _differential_evolution(ev: _Evaluations, seed, tol, budget, popsize):
 def _base_actuator(actuator, folder: Optional[Path]):
     """The study's ``actuator`` setting: a catalog id or a file's path as given; an Actuator
     object is written as an actuator file (in the output folder, else a temporary one)."""
-    from .model.actuator import Actuator
+    from ..model.actuator import Actuator
     if isinstance(actuator, Path):
         return str(actuator), None
     if isinstance(actuator, Actuator):
-        from .model.actuator_file import write_actuator
+        from ..model.actuator_file import write_actuator
         tmp = None
         if folder is None:
             tmp = tempfile.TemporaryDirectory(prefix="mjeap-optimize-")
@@ -376,7 +377,7 @@ def _base_actuator(actuator, folder: Optional[Path]):
 
 def _wave_settings(voltage) -> dict:
     """The sweep's waveform settings of a waveform text (step, square, sine or triangle)."""
-    from .drives.waveforms import parse_waveform
+    from ..drives.waveforms import parse_waveform
     from .sweep import SWEEP_WAVEFORMS
     w = parse_waveform(voltage)
     if w.kind not in SWEEP_WAVEFORMS or w.phase or w.delay or (w.kind == "square" and w.duty != 0.5):
@@ -394,9 +395,9 @@ def optimize(actuator, vary: Mapping[str, object], maximize: Optional[str] = Non
              seed: int = 0, max_evaluations: int = 400, out=None, progress: Optional[bool] = None,
              tol: float = 1e-7, fd_step: float = 1e-3, feasibility: float = 1e-6, active: float = 1e-3,
              maxiter: int = 100, popsize: int = 10, de_tol: float = 1e-2) -> OptimizeResult:
-    """Maximise (``maximize``) or minimise (``minimize``) one metric of :mod:`mjeap.sweep`
+    """Maximise (``maximize``) or minimise (``minimize``) one metric of :mod:`mjeap.studies.sweep`
     over the box ``vary`` (name -> (low, high), SI numbers or texts with units, or
-    ``"LOW:HIGH"``; names ``actuator.X`` of :mod:`mjeap.design`, ``drive.NAME``,
+    ``"LOW:HIGH"``; names ``actuator.X`` of :mod:`mjeap.model.variants`, ``drive.NAME``,
     ``payload_mass``, ``payload_position``, ``amplitude``, ``offset``, ``frequency``, ...),
     subject to ``subject_to`` (``"first_frequency>=800"``, :func:`parse_constraint`).
 
@@ -415,10 +416,10 @@ def optimize(actuator, vary: Mapping[str, object], maximize: Optional[str] = Non
     ``maxiter`` (SLSQP iterations per start), ``popsize`` and ``de_tol`` (differential
     evolution), ``feasibility`` and ``active`` (relative tolerances: a constraint met, a
     constraint active). Evaluations run one at a time in this process."""
-    from . import design
-    from .io.outputs import check_outputs, hold, replacing
+    from ..model import variants
+    from ..io.outputs import check_outputs, hold, replacing
     from .sweep import METRICS, STATIC_METRICS, check_metric_settings, check_settings
-    from .sweep.design import _check_names
+    from .sweep.points import _check_names
     from .sweep.runner import _drop_torn_row, _read_sweep_csv, _RowFile
 
     t0 = time.perf_counter()
@@ -466,7 +467,7 @@ def optimize(actuator, vary: Mapping[str, object], maximize: Optional[str] = Non
             raise ParameterError("base", "actuator", "the actuator as optimize's first argument, not in base/--set")
         _check_names(fixed)
         fixed["actuator"] = base_name
-        act0 = design.get_base(base_name)
+        act0 = variants.get_base(base_name)
         names = sorted(vary)
         bounds = [parse_bounds(n, vary[n], base_name) for n in names]
         clash = [n for n in names if n in fixed]
@@ -487,7 +488,7 @@ def optimize(actuator, vary: Mapping[str, object], maximize: Optional[str] = Non
         check_settings(corners, fixed)
         check_metric_settings(corners, fixed, wanted)
         for c in corners:                       # the box's corners build (a stack the drive takes)
-            design.design_actuator(base_name, c)
+            variants.design_actuator(base_name, c)
         columns = ["point_id", *names, *wanted, "error", "wall_s", "settings"]
         # ---- the run
         from threadpoolctl import threadpool_limits
@@ -598,7 +599,7 @@ def _run(names, lo, hi, wanted, fixed, cached, writer, columns, max_evaluations,
     feasible = ev.best is not None
     act = None
     try:
-        from .design import design_actuator
+        from ..model.variants import design_actuator
         act = design_actuator(base_name, {**fixed, **point})     # fixed actuator.X (--set) too
         drive_set = {k[6:]: v for k, v in {**fixed, **point}.items() if k.startswith("drive.")}
         if drive_set:

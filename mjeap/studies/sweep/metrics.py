@@ -11,9 +11,9 @@ from typing import Callable, Dict, Optional, Sequence
 
 import numpy as np
 
-from ..errors import DivergenceError, ParameterError, check_registration
-from ..simulation.metric_accuracy import reported_value
-from .design import PARAMETERS
+from ...errors import DivergenceError, ParameterError, check_registration
+from ...simulation.metric_accuracy import reported_value
+from .points import PARAMETERS
 
 
 def _period(point) -> Optional[float]:

@@ -3,7 +3,7 @@ on local processes or on Dask, streamed to CSV as they complete and resumable
 (:func:`read_results` reads the CSV back).
 
 Every finished point is appended to the CSV (and flushed) at once, keyed by a hash of its
-parameters (:func:`mjeap.sweep.design.point_id`), so an interrupted sweep keeps what finished
+parameters (:func:`mjeap.studies.sweep.points.point_id`), so an interrupted sweep keeps what finished
 and a rerun with the same file skips it. A point that fails (bad input, divergence) records
 its error in the ``error`` column instead of stopping the sweep.
 
@@ -29,12 +29,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import List, Optional, Sequence
 
-from ..io import csvio
-from ..errors import (DivergenceError, MjeapError, OutputError, ParameterError, UnknownNameError, check_integer,
+from ...io import csvio
+from ...errors import (DivergenceError, MjeapError, OutputError, ParameterError, UnknownNameError, check_integer,
                       sigterm_as_interrupt)
-from ..io.outputs import hold
+from ...io.outputs import hold
 from . import metrics as _metrics      # its registries, read where a point runs
-from .design import (PARAMETERS, _check_names, _duration, _scene, _wave_text, check_design_size, check_settings,
+from .points import (PARAMETERS, _check_names, _duration, _scene, _wave_text, check_design_size, check_settings,
                      point_id, settings)
 from .metrics import check_metric_settings, metric_value
 
@@ -86,7 +86,7 @@ def _run_point(p: dict, scene, metrics: Sequence[str], rrd_dir, pid: str, error_
     """The rollout of a point, sampled as its metrics need: every step (every k steps beyond
     MAX_STEP_SAMPLES) for STEP_METRICS, sparsely where every metric reads only the run's end
     (END_METRICS: the scene holds the end), else the rollout's default."""
-    from ..simulation.rollout import rollout
+    from ...simulation.rollout import rollout
     wave = _wave_text(p)
     duration = _duration(p)
     drive_params = {k[6:]: v for k, v in p.items() if k.startswith("drive.")}
@@ -110,7 +110,7 @@ def targeted_metrics(metrics: Sequence[str]) -> tuple:
     """The metrics an accuracy target applies to (:mod:`mjeap.simulation.metric_accuracy`):
     all the point's rollout metrics where each is one it answers (bookkeeping columns
     aside), else none (the target is then on the trajectory)."""
-    from ..simulation.metric_accuracy import BOOKKEEPING, answerable
+    from ...simulation.metric_accuracy import BOOKKEEPING, answerable
     return tuple(m for m in metrics if m not in BOOKKEEPING) if answerable(metrics) else ()
 
 
@@ -315,14 +315,14 @@ WORKER_DIED = ("worker process died while running this point (killed, e.g. by th
 
 
 class _SceneQueue:
-    """Jobs grouped by their point's scene (:func:`mjeap.sweep.design.scene_key`), in their
+    """Jobs grouped by their point's scene (:func:`mjeap.studies.sweep.points.scene_key`), in their
     order: a worker that just finished a point takes another of the same scene (built and
     kept in that process, :meth:`mjeap.Scene.shared`), else the first of a scene no running
     point holds, else the first (with one point in flight per worker, the job submitted
     after a point finishes goes to the worker that ran it)."""
 
     def __init__(self, jobs):
-        from .design import scene_key
+        from .points import scene_key
         self.groups: "OrderedDict[str, deque]" = OrderedDict()
         for job in jobs:
             self.groups.setdefault(scene_key({**PARAMETERS, **(job[2] or {}), **job[0]}), deque()).append(job)

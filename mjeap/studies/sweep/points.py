@@ -5,7 +5,7 @@ the Scene and waveform a point's parameters make.
 
 A point is a dict of :data:`PARAMETERS` (scene, waveform and rollout settings, SI) plus
 ``drive.NAME`` entries for drive parameters and ``actuator.X`` entries for the actuator's
-geometry and materials (:mod:`mjeap.design` builds the point's actuator from the base one).
+geometry and materials (:mod:`mjeap.model.variants` builds the point's actuator from the base one).
 """
 from __future__ import annotations
 
@@ -19,7 +19,7 @@ from typing import Dict, Iterable, List, Optional, Sequence
 
 import numpy as np
 
-from ..errors import MjeapError, ParameterError, UnknownNameError
+from ...errors import MjeapError, ParameterError, UnknownNameError
 
 #: the most points one sweep design may have (each is a rollout, and the design is held in
 #: memory): a larger design is refused before it is built, naming its count; split it into
@@ -42,7 +42,7 @@ def _check_names(names: Iterable[str]) -> None:
     for n in names:
         if n not in PARAMETERS and not n.startswith("drive.") and not n.startswith("actuator."):
             raise ParameterError("sweep parameter", n, f"one of {', '.join(PARAMETERS)}, drive.NAME or actuator.NAME "
-                                 "(mjeap.design: actuator.length, actuator.layers.LAYER.thickness, ...)")
+                                 "(mjeap.model.variants: actuator.length, actuator.layers.LAYER.thickness, ...)")
 
 
 def check_design_size(count: int, name: str = "design", how: str = "") -> int:
@@ -85,7 +85,7 @@ def random_design(n: int, seed: int = 0, **ranges) -> List[dict]:
 def settings(base: Optional[dict] = None, metrics: Sequence[str] = ()) -> dict:
     """Everything besides a point's own parameters that changes its row: the fixed
     parameters (``base`` over the defaults), the metrics and the package version."""
-    from ..versions import MJEAP_VERSION
+    from ...versions import MJEAP_VERSION
     return {"base": {**PARAMETERS, **(base or {})}, "metrics": sorted(metrics), "mjeap": MJEAP_VERSION}
 
 
@@ -105,7 +105,7 @@ _FILE_DIGESTS: Dict[tuple, str] = {}
 def _actuator_file_digest(actuator) -> Optional[str]:
     """SHA-1 of an actuator file's bytes (None: a catalog id, an Actuator or no such file),
     so that a point of an edited file is computed again; cached by path, size and mtime."""
-    from ..model.actuator_file import is_actuator_file
+    from ...model.actuator_file import is_actuator_file
     if not isinstance(actuator, (str, Path)) or not is_actuator_file(actuator):
         return None
     try:
@@ -124,13 +124,13 @@ def _actuator_file_digest(actuator) -> Optional[str]:
 def check_settings(points: Sequence[dict], base: Optional[dict]) -> None:
     """Every name in ``base`` is a sweep parameter, and every ``drive.NAME`` (in base or the
     points) a parameter of the actuator's drive; else UnknownNameError with the closest."""
-    from ..drives import default_drive_name, get_drive_class
+    from ...drives import default_drive_name, get_drive_class
     base = base or {}
     for n in base:
         if n not in PARAMETERS and not n.startswith("drive.") and not n.startswith("actuator."):
             raise UnknownNameError("fixed sweep setting (--set / base)", n,
                                    [*PARAMETERS, "drive.NAME", "actuator.NAME"])
-    from ..model.catalog import check_actuator_files      # a bad actuator file: refused before any point
+    from ...model.catalog import check_actuator_files      # a bad actuator file: refused before any point
     check_actuator_files({**PARAMETERS, **base, **p}["actuator"] for p in points or [{}])
     _check_designs(points, base)
     _check_fixed(points, base)
@@ -143,8 +143,8 @@ def check_settings(points: Sequence[dict], base: Optional[dict]) -> None:
             continue
         act = str(full["actuator"])
         try:
-            from ..model.actuator_file import is_actuator_file
-            from ..model.catalog import get_actuator
+            from ...model.actuator_file import is_actuator_file
+            from ...model.catalog import get_actuator
             cls = get_drive_class(default_drive_name(get_actuator(act) if is_actuator_file(act) else act))
         except MjeapError:
             continue              # a user actuator or an unknown one: the point reports it
@@ -155,16 +155,16 @@ def check_settings(points: Sequence[dict], base: Optional[dict]) -> None:
 
 
 def _check_designs(points: Sequence[dict], base: dict) -> None:
-    """The ``actuator.X`` parameters of a study (:mod:`mjeap.design`), checked before any
+    """The ``actuator.X`` parameters of a study (:mod:`mjeap.model.variants`), checked before any
     point runs: each name against its point's base actuator, every value against its range,
     and the actuator of each base actuator's first point built (its sizes and its drive's
     layer stack)."""
-    from .. import design as actuator_design
+    from ...model import variants
     by_actuator: Dict[str, Dict[str, list]] = {}
     firsts: Dict[str, dict] = {}
     for p in points or [{}]:
         full = {**PARAMETERS, **base, **p}
-        names = [k for k in full if actuator_design.is_design_parameter(k)]
+        names = [k for k in full if variants.is_design_parameter(k)]
         if not names:
             continue
         act = full["actuator"]
@@ -176,11 +176,11 @@ def _check_designs(points: Sequence[dict], base: dict) -> None:
     for key, vals in by_actuator.items():
         act = firsts[key]["actuator"]
         try:
-            actuator_design.get_base(act)
+            variants.get_base(act)
         except MjeapError:
             continue                # an unknown actuator: each point reports it
-        actuator_design.check_design(act, {name: list(dict.fromkeys(values)) for name, values in vals.items()})
-        actuator_design.design_actuator(act, {k: v for k, v in firsts[key].items() if k != "actuator"})
+        variants.check_design(act, {name: list(dict.fromkeys(values)) for name, values in vals.items()})
+        variants.design_actuator(act, {k: v for k, v in firsts[key].items() if k != "actuator"})
 
 
 def _check_fixed(points: Sequence[dict], base: dict) -> None:
@@ -189,9 +189,9 @@ def _check_fixed(points: Sequence[dict], base: dict) -> None:
     a target in the accepted range (or None), ``waveform`` one of SWEEP_WAVEFORMS,
     ``duration`` finite and > 0 s and, where no point varies it (and without an accuracy
     target, which chooses the step), at most MAX_STEPS steps of the first point's scene."""
-    from ..engines.frame import MAX_STEPS
-    from ..errors import check_positive
-    from ..simulation.accuracy import check_accuracy
+    from ...engines.frame import MAX_STEPS
+    from ...errors import check_positive
+    from ...simulation.accuracy import check_accuracy
     fixed = "a fixed sweep setting (--set / base): every point would fail with it"
     try:
         if base.get("accuracy") not in (None, ""):
@@ -228,7 +228,7 @@ SCENE_PARAMETERS = ("actuator", "representation", "segments", "orientation", "pa
 def scene_key(p: dict) -> str:
     """What a point's scene is built from (its full parameters ``p``), as text: points with
     the same key share a scene (:func:`_scene`)."""
-    from ..design import is_design_parameter
+    from ...model.variants import is_design_parameter
     return json.dumps({k: v for k, v in p.items() if k in SCENE_PARAMETERS or is_design_parameter(k)},
                       sort_keys=True, default=str)
 
@@ -236,15 +236,15 @@ def scene_key(p: dict) -> str:
 def _scene(p: dict):
     """The Scene of a point's full parameters (``base`` and the defaults filled in), shared
     with the earlier points of the same scene in this thread (:meth:`Scene.shared`)."""
-    from ..model.discretize import Payload
-    from ..simulation.scene import Scene
+    from ...model.discretize import Payload
+    from ...simulation.scene import Scene
     payload = None
     if p["payload_mass"]:
         pos = p["payload_position"]
         if pos is None:
             raise ParameterError("payload_position", None, "a position in m when payload_mass > 0")
         payload = Payload(float(p["payload_mass"]), float(pos))
-    from ..design import design_actuator, is_design_parameter
+    from ...model.variants import design_actuator, is_design_parameter
     act = p["actuator"]
     if any(is_design_parameter(k) for k in p):
         act = design_actuator(act, p)
@@ -267,7 +267,7 @@ def _duration(p: dict) -> float:
 
 def _check_stop(p: dict) -> None:
     """A point's periodic stop, as its rollout will check it (mjeap.simulation.rollout.check_stop)."""
-    from ..drives.waveforms import parse_waveform
-    from ..simulation.rollout import check_stop
+    from ...drives.waveforms import parse_waveform
+    from ...simulation.rollout import check_stop
     check_stop(float(p["stop_when_periodic"]), parse_waveform(_wave_text(p)), _duration(p),
                at_accuracy=p["accuracy"] not in (None, ""))

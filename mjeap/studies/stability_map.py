@@ -1,22 +1,60 @@
-"""The stability map of seed 000's inverted actuator as a command line: a sweep of payload
-mass x drive amplitude (:mod:`mjeap.sweep`), judged by seed 000's criterion, with the
-theory limits of :mod:`mjeap.analysis.stability` drawn over it; writes results.csv (resumable),
-stability_map.png, report.md and stability_map.rrd (``python scripts/stability_map.py``)."""
+"""The stability map of Dadras et al. 2021's inverted actuator under a payload: a sweep of
+payload mass x drive amplitude (:mod:`mjeap.studies.sweep`), judged by the paper's criterion
+(the tip curvature still changes sign in the third period of the square wave), with the
+theory boundaries drawn over it (:func:`column_limits`) and the simulated edge read off the
+sweep (:func:`simulated_edges`); as a command line (:func:`main`, ``python
+scripts/stability_map.py``) it writes results.csv (resumable), stability_map.png, report.md
+and stability_map.rrd.
+
+The beam stands up (clamp below), the payload sits at l_e past the clamp on a rigid arm
+beyond the beam's end (L = 6 mm, l_e = 6.27 mm). Theory is amplitude independent: the
+Euler column with the payload on the arm (k a tan(kL) = 1, :func:`analytical.critical_load_with_arm`)
+with the instantaneous EI of eq. 8 and with its relaxed (DC) EI, x pole/zero = 0.3/0.52,
+and the paper's own Region 3 model's marginal mass."""
 from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import Dict, Sequence
 
 import numpy as np
 
-from .io.commandline import arg_integer, arg_output, parse_args
-from .io.outputs import replacing
-from .io.recording import rrd_file
-from .analysis.stability import MAP_BASE, column_limits, simulated_edges
-from .engines import ENGINES
+from ..io.commandline import arg_integer, arg_output, parse_args
+from ..io.outputs import replacing
+from ..io.recording import rrd_file
+from ..model import analytical as an
+from ..engines import ENGINES
 from .sweep import EXECUTORS, grid, read_results, run_sweep
 
-__all__ = ["main"]
+__all__ = ["MAP_BASE", "column_limits", "simulated_edges", "main"]
+
+#: the sweep base of seed 000's map: standing up, payload at l_e, 0.1 Hz square wave, 30 s
+#: (three periods)
+MAP_BASE = dict(actuator="pedot-micro", orientation="up", payload_position=6.27e-3, waveform="square",
+                frequency=0.1, duration=30.0)
+
+
+def column_limits(l_e: float = 6.27e-3, length: float = 6e-3) -> Dict[str, float]:
+    """Payload masses (kg) of the theory boundaries, by name."""
+    model = an.DadrasModel()
+    ei, g = 1.0 / model.mechanical_gain, model.gravity
+    p_arm = an.critical_load_with_arm(length, ei, l_e - length)
+    return {"column, instantaneous EI": p_arm / g,
+            "column, relaxed EI (static limit)": model.pole / model.zero * p_arm / g,
+            "paper's Region 3 model (marginal)": model.marginal_mass(l_e)}
+
+
+def simulated_edges(mass: Sequence[float], amplitude: Sequence[float], returns: Sequence[bool]) -> Dict[float, float]:
+    """Per amplitude: the mass midway between the heaviest returning point and the lightest
+    heavier one that does not return (NaN where the sweep does not bracket the edge)."""
+    m, v, ok = np.asarray(mass, float), np.asarray(amplitude, float), np.asarray(returns, bool)
+    edges = {}
+    for amp in np.unique(v):
+        sel = v == amp
+        good, bad = m[sel & ok], m[sel & ~ok]
+        above = bad[bad > good.max()] if good.size else bad
+        edges[float(amp)] = 0.5 * (good.max() + above.min()) if good.size and above.size else float("nan")
+    return edges
 
 
 MAP_DESCRIPTION = "Stability map of the PEDOT micro trilayer standing up (seed 000): payload mass x drive amplitude."
@@ -49,7 +87,7 @@ def main(argv=None):
                          "third period's end on: needs --periods 4 or more; refused before any point otherwise)")
     a = parse_args(ap, argv)
     if a.accuracy is not None:
-        from .simulation.accuracy import check_accuracy
+        from ..simulation.accuracy import check_accuracy
         check_accuracy(a.accuracy)
     out = Path(a.out)
     masses = np.linspace(0.0, 150e-6, a.masses)[1:]

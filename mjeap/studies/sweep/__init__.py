@@ -3,7 +3,7 @@ local processes or on Dask, streamed to CSV as they complete and resumable.
 
 A point is a dict of :data:`PARAMETERS` (scene, waveform and rollout settings, SI) plus
 ``drive.NAME`` entries for drive parameters and ``actuator.X`` entries for the actuator's
-geometry and materials (:mod:`mjeap.design` builds the point's actuator from the base one).
+geometry and materials (:mod:`mjeap.model.variants` builds the point's actuator from the base one).
 Metrics that read the scene alone (:data:`STATIC_METRICS`: ``first_frequency``, ``mass``) run
 no rollout; the others run one, sampled as they need. :func:`grid` and :func:`random_design` make
 designs; :func:`run_sweep` evaluates them. Every finished point is appended to the CSV
@@ -16,14 +16,14 @@ Executors: ``"processes"`` (``concurrent.futures``, the default), ``"serial"``, 
 ``tcp://host:8786``) or, without one, on a ``LocalCluster`` of ``workers`` processes. The
 same code runs on all three; Dask is the optional ``sweep`` extra.
 
-The package's three modules, each on the one below: :mod:`mjeap.sweep.design` (the points:
+The package's three modules, each on the one below: :mod:`mjeap.studies.sweep.points` (the points:
 their parameters, designs, keys and the checks before any point runs),
-:mod:`mjeap.sweep.metrics` (the metrics and their registry) and :mod:`mjeap.sweep.runner`
+:mod:`mjeap.studies.sweep.metrics` (the metrics and their registry) and :mod:`mjeap.studies.sweep.runner`
 (one point's row, many points to CSV, the executors). Their public names are here.
 """
-from .design import (MAX_POINTS, PARAMETERS, SWEEP_WAVEFORMS, check_design_size, check_settings, grid, point_id,
+from .points import (MAX_POINTS, PARAMETERS, SWEEP_WAVEFORMS, check_design_size, check_settings, grid, point_id,
                      random_design, settings)
-from .design import _scene, _wave_text  # noqa: F401  (a point's Scene and waveform text, as the runner makes them)
+from .points import _scene, _wave_text  # noqa: F401  (a point's Scene and waveform text, as the runner makes them)
 from .metrics import (END_METRICS, METRIC_UNITS, METRICS, OWN_SCENE_METRICS, STATIC_METRICS, STEP_METRICS,
                       check_metric_settings, metric_value, register_metric)
 from .runner import (EXECUTORS, SweepSummary, evaluate, read_results, run_sweep, stop_workers, worker_signals)

@@ -1,5 +1,5 @@
-"""Actuator designs in studies: ``actuator.X`` parameters of a sweep or an optimisation
-mapped onto a modified :class:`~mjeap.Actuator` (one helper, :func:`design_actuator`).
+"""Actuator variants: ``actuator.X`` parameters (of a sweep or an optimisation) mapped onto a
+modified :class:`~mjeap.Actuator` (one helper, :func:`design_actuator`).
 
 A point's actuator is its base actuator (a catalog id or an actuator file, the study's
 ``actuator`` setting) with these replaced (``dataclasses.replace``), SI or, in text, with a
@@ -22,7 +22,9 @@ parameters (its gains) are not rescaled: vary them as ``drive.NAME``.
 
 Every value is checked against its range (:func:`check_design_value`; an error names the
 parameter and the range) and the modified actuator against the drive's layer stack (a
-piezo bimorph's plates must stay equally thick), before any work.
+piezo bimorph's plates must stay equally thick; the drives' answer, installed from the
+floor above as for actuator files, :func:`mjeap.model.actuator_file.drive_info`), before
+any work.
 """
 from __future__ import annotations
 
@@ -30,10 +32,12 @@ import dataclasses
 import warnings
 from typing import Dict, List, Mapping, Optional
 
-from .errors import ParameterError, UnknownNameError
+from ..errors import ParameterError, UnknownNameError
+from .actuator_file import drive_info
 
 __all__ = ["PREFIX", "PLANFORM", "LAYER_FIELDS", "is_design_parameter", "design_parameter_names",
-           "check_design_value", "check_design", "design_actuator", "get_base", "parameter_unit", "to_value", "DESIGN_SOURCE"]
+           "check_design_value", "check_design", "design_actuator", "get_base", "design_unit", "parse_design_name",
+           "DESIGN_SOURCE"]
 
 PREFIX = "actuator."
 #: planform fields: unit, whether zero is allowed
@@ -42,20 +46,14 @@ PLANFORM = {"length": ("m", False), "base_width": ("m", False), "tip_width": ("m
 #: layer fields and their units
 LAYER_FIELDS = {"thickness": "m", "width": "m", "youngs_modulus": "Pa", "density": "kg/m^3", "poisson_ratio": "-"}
 #: what a value set by a study says of its source
-DESIGN_SOURCE = "set by a design study (mjeap.design)"
-#: units of the sweep's own numeric parameters (mjeap.sweep.PARAMETERS)
-SWEEP_UNITS = {"payload_mass": "kg", "payload_position": "m", "amplitude": "V", "frequency": "Hz", "offset": "V",
-               "duration": "s", "initial_curvature": "1/m", "damping_ratio": "-", "accuracy": "-",
-               "stop_when_periodic": "-"}
-
-
+DESIGN_SOURCE = "set by a design study (mjeap.model.variants)"
 def is_design_parameter(name: str) -> bool:
     return isinstance(name, str) and name.startswith(PREFIX)
 
 
 def get_base(actuator):
     """The base actuator of a study: a catalog id, a file's path or an Actuator."""
-    from .model.catalog import get_actuator
+    from .catalog import get_actuator
     return get_actuator(actuator)
 
 
@@ -69,7 +67,7 @@ def design_parameter_names(actuator) -> List[str]:
     return names
 
 
-def _parse(name: str, act):
+def parse_design_name(name: str, act):
     """(kind, key, field): ('planform', field, None), ('width', None, None), ('damping',
     None, None), ('layers', layer name, field) or ('roles', role, field); an unknown name
     raises UnknownNameError with the actuator's names."""
@@ -89,50 +87,19 @@ def _parse(name: str, act):
     raise UnknownNameError(f"design parameter of {act.id} (actuator.X)", name, design_parameter_names(act))
 
 
-def parameter_unit(name: str, actuator=None) -> Optional[str]:
-    """The SI unit of a study parameter: ``actuator.X`` (from its field), ``drive.NAME`` (the
-    drive's own unit, where ``actuator`` names one) or a sweep parameter; None where it has
-    none (text parameters, a drive parameter of an unknown drive)."""
-    if is_design_parameter(name):
-        rest = name[len(PREFIX):]
-        if rest in PLANFORM:
-            return PLANFORM[rest][0]
-        if rest == "width":
-            return "m"
-        if rest == "damping_ratio":
-            return "-"
-        fld = rest.rpartition(".")[2]
-        return LAYER_FIELDS.get(fld)
-    if name.startswith("drive."):
-        if actuator is None:
-            return None
-        try:
-            from .drives import default_drive_name, get_drive_class
-            unit = get_drive_class(default_drive_name(get_base(actuator))).parameter_units().get(name[6:])
-        except Exception:          # noqa: BLE001 - an unknown actuator or drive: the point reports it
-            return None
-        return unit
-    return SWEEP_UNITS.get(name)
-
-
-def to_value(name: str, text, actuator=None):
-    """A study parameter's value from text: SI for a parameter with a unit (``"8mm"`` ->
-    0.008, a bare number SI); the number or the text itself for the others."""
-    if not isinstance(text, str):
-        return text
-    unit = parameter_unit(name, actuator)
-    if unit is None and is_design_parameter(name):
-        _parse(name, get_base(actuator if actuator is not None else "pedot-micro"))   # unknown: named, with the known
-    if unit is not None:
-        try:
-            float(text)
-        except ValueError:
-            from .model.quantity import to_si
-            return to_si(text.strip(), unit, name)
-    try:
-        return float(text)
-    except ValueError:
-        return text
+def design_unit(name: str) -> Optional[str]:
+    """The SI unit of the design parameter ``name`` (``actuator.X``, from its field); None for
+    any other name."""
+    if not is_design_parameter(name):
+        return None
+    rest = name[len(PREFIX):]
+    if rest in PLANFORM:
+        return PLANFORM[rest][0]
+    if rest == "width":
+        return "m"
+    if rest == "damping_ratio":
+        return "-"
+    return LAYER_FIELDS.get(rest.rpartition(".")[2])
 
 
 def check_design_value(name: str, value, actuator=None) -> float:
@@ -141,10 +108,10 @@ def check_design_value(name: str, value, actuator=None) -> float:
     Poisson ratio in (-1, 0.5); a damping ratio in (0, 1)); a layer value of a library
     material more than 1000 x outside the material's range is refused (outside it, a
     RangeWarning). Raises ParameterError naming the parameter and the range."""
-    from .model import materials as mat
+    from . import materials as mat
     act = get_base(actuator) if actuator is not None else None
-    kind, key, fld = _parse(name, act) if act is not None else (None, None, None)
-    unit = parameter_unit(name) or ""
+    kind, key, fld = parse_design_name(name, act) if act is not None else (None, None, None)
+    unit = design_unit(name) or ""
     try:
         v = float(value)
     except (TypeError, ValueError):
@@ -185,7 +152,7 @@ def design_actuator(actuator, params: Mapping[str, object]):
     (:func:`check_design_value`, material-range warnings left to the study's own check),
     the modified actuator's sizes and its drive's layer stack; a ParameterError names the
     parameter. Without design entries the base actuator itself is returned."""
-    from .model.actuator import validate_actuator
+    from .actuator import validate_actuator
     base = get_base(actuator)
     given = {k: v for k, v in params.items() if is_design_parameter(k)}
     if not given:
@@ -194,7 +161,7 @@ def design_actuator(actuator, params: Mapping[str, object]):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")          # material ranges: warned once by the study's check
         for name, value in given.items():
-            kind, key, fld = _parse(name, base)
+            kind, key, fld = parse_design_name(name, base)
             v = check_design_value(name, value, base)
             if kind == "planform":
                 planform[key] = v
@@ -255,12 +222,15 @@ def design_actuator(actuator, params: Mapping[str, object]):
 
 
 def _stack_reason(act) -> Optional[str]:
-    from .drives import default_drive_name, get_drive_class
+    """Why the actuator's drive cannot take its layer stack (None: it can, or no drive layer
+    answers, or the drive is unknown: the run names it)."""
+    info = drive_info()
+    if info is None:
+        return None
     try:
-        cls = get_drive_class(default_drive_name(act))
+        return info.stack_reason(info.default(act), act)
     except (UnknownNameError, ParameterError):
         return None
-    return cls.stack_reason(act)
 
 
 def check_design(actuator, values: Mapping[str, List[object]]) -> Dict[str, List[float]]:
@@ -273,7 +243,7 @@ def check_design(actuator, values: Mapping[str, List[object]]) -> Dict[str, List
     for name, vals in values.items():
         if not is_design_parameter(name):
             continue
-        _parse(name, act)
+        parse_design_name(name, act)
         out[name] = [_quiet_check(name, v, act) for v in vals]
         if out[name]:                       # the range's ends: a material-range warning once each
             for end in {min(out[name]), max(out[name])}:
