@@ -245,6 +245,18 @@ class Drive:
     def extra_parameters(self) -> Tuple[str, ...]:
         return ()
 
+    @contextmanager
+    def _acting_on(self, part):
+        """Within the block the drive's loop methods (:meth:`step`, :meth:`signals`) act on
+        ``part`` (a read-only view when replaying on a model that already drives the beam),
+        its own part again after it: the one place a drive's part changes, the drive's own."""
+        own = self.part
+        self.part = part
+        try:
+            yield
+        finally:
+            self.part = own
+
     # -- to implement ------------------------------------------------------------------
     def reset(self, initial_curvature: float = 0.0) -> None:
         """Reset the drive state; the scene is already reset (and bent, if asked)."""
@@ -364,14 +376,10 @@ class NativeForm:
         the model's full-physics state before step k, which the replayed step starts from
         as the loop's does (a drive reading the beam's rates needs it: the piezo bimorph's
         motional current); None: the state after it."""
-        own = self.part
-        self.part = ReadOnlyPart(own)
-        try:
+        with self._acting_on(ReadOnlyPart(part)):
             with _state_before(part, before):
                 self.seek(k)
             return self.signals()
-        finally:
-            self.part = own
 
     def native_signal_history(self, ks: np.ndarray, states: np.ndarray, part, handles,
                               prefix: str = "") -> Optional[Dict[str, np.ndarray]]:

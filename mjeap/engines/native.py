@@ -59,8 +59,6 @@ def run_native(scene, native, drives: Sequence, v_steps: Sequence[np.ndarray], i
     # the controls: the voltage (ctrl), and the tip loads where the scene has them
     spec = NATIVE_CONTROL | (LOADS if scene.part.has_tip_load() else 0)
     template = np.empty(mujoco.mj_stateSize(m, spec))
-    for drv in drives:          # the drives' signals read the native model's state
-        drv.part = part
     # drives that compute their signals from the states at the end keep those rows
     batch = [type(drv).native_signal_history is not NativeForm.native_signal_history for drv in drives]
     rows = [np.empty((len(sample_steps), state0.shape[1])) if bt else None for bt in batch]
@@ -109,8 +107,6 @@ def run_native(scene, native, drives: Sequence, v_steps: Sequence[np.ndarray], i
             if batch[b]:
                 n_b = samples[b].n
                 samples[b].sig = drives[b].native_signal_history(sample_steps[:n_b], rows[b][:n_b], part, h)
-        for drv in drives:
-            drv.part = scene.part
     # the scene and the (last) drive as the loop leaves them: final state, last moments applied
     mujoco.mj_setState(m, d, final[-1], STATE)
     mujoco.mj_kinematics(m, d)

@@ -404,11 +404,7 @@ def run_from_states(scene, drive, wave, duration: float, initial_curvature: floa
         pos, rot = kin
         site = pos[:, 1] + rot @ m.site_pos[part.tip_site_id]
         return TipPath(steps * dt, part.clamp_frame(site - pos[:, 0]))
-    drive.part = part
-    try:
-        sig = drive.native_signal_history(steps, rows, part, native.handles)
-    finally:
-        drive.part = scene.part
+    sig = drive.native_signal_history(steps, rows, part, native.handles)
     bodies = [part.clamp_id, *part.link_ids, part.tip_body_id] + ([part.payload_id] if part.payload_id >= 0 else [])
     kin = chain_kinematics(m, rows[:, 1:1 + m.nq], bodies, part.tip_body_id)
     if sig is None or kin is None:

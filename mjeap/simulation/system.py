@@ -724,10 +724,9 @@ class System:
         pos, quat, fc = np.empty((ns, nb, 3)), np.empty((ns, nb, 4)), np.empty((ns, nb, 3))
         m, d = self.model, self.data
         self.reset(initial_curvatures)
-        for a, p, v in zip(self.actuators, self.parts, v_steps):
+        for a, v in zip(self.actuators, v_steps):
             if v is not None:
                 a.drive.native_prepare(v, dt)
-                a.drive.part = p
         active = [(i, v) for i, v in zip(self.actuator_ids, v_steps) if v is not None]
         ws = np.empty(m.nv)
         # the state before each sampled step: a drive's signals replay that step from it
