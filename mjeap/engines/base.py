@@ -46,11 +46,20 @@ class SceneTarget(Target, Protocol):
 @runtime_checkable
 class SystemTarget(Target, Protocol):
     """Several actuators in one model (:class:`mjeap.System`): their parts, attached
-    actuators and the ids of their MuJoCo actuators (-1: passive)."""
+    actuators and the ids of their MuJoCo actuators (-1: passive), its units; reset to arcs,
+    a controller's voltages checked and held, the contact forces on its bodies
+    (:class:`mjeap.engines.system_frame.SystemRun` steps it)."""
 
     parts: List[Any]
     actuators: List[Any]
     actuator_ids: List[int]
+    units: Any
+
+    def reset(self, initial_curvatures: Any = 0.0) -> None: ...
+
+    def hold_voltages(self, voltages: Any, v_steps: Sequence, k: int, who: str) -> None: ...
+
+    def contact_forces(self) -> Any: ...
 
 #: why an engine that precomputes the run (native, threaded) cannot take a controller
 CONTROLLER_REASON = "a controller closes the loop (its voltage depends on the state)"

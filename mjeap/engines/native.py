@@ -8,11 +8,20 @@ from typing import Optional, Sequence
 import mujoco
 import numpy as np
 
+from mujoco import rollout as mj_rollout
+
 from ..drives.base import NativeForm
+from ..model.chain import chain_kinematics
 from ..model.mjcf import HINGE_TENDON
 from .base import CONTROLLER_REASON, Engine
 from .frame import Decided
-from .threaded import LOADS, NATIVE_CONTROL, STATE, ahead_of_stop, raise_bad, roll, spare_datas
+from .result import TipPath
+from .threaded import LOADS, MAXVAL, NATIVE_CONTROL, STATE, ahead_of_stop, raise_bad, roll, spare_datas
+
+
+class StatesUnread(Exception):
+    """A run the native engine cannot read from its states (:meth:`NativeEngine.read_states`):
+    the run goes the ordinary way, which says why where it fails."""
 
 
 def why_not(scene, drive, controller=None) -> Optional[str]:
@@ -43,6 +52,69 @@ class NativeEngine(Engine):
             check_every=100, controller=None, meta=None) -> None:
         run_native(scene, scene.native_model(drives[0]), drives, v_steps, initial_curvatures, sample_steps, samples,
                    nthread=nthread)
+
+    # -- a mode: the run sampled every step, read from the states mujoco.rollout returns ----
+    def states_reason(self, scene, drive) -> Optional[str]:
+        """None where a run of ``scene`` with ``drive`` can be read from its states
+        (:meth:`read_states`); else why not."""
+        why = why_not(scene, drive)
+        if why is not None:
+            return why
+        if scene.part.has_tip_load():
+            return "the tip loads are per-step controls"
+        if type(drive).native_signal_history is NativeForm.native_signal_history:
+            return f"the {drive.name} drive reads its signals one sample at a time"
+        return None
+
+    def read_states(self, scene, drive, v_steps: np.ndarray, initial_curvature: float, samples, *,
+                    tip_only: bool = False) -> Optional[TipPath]:
+        """One run of ``scene`` (:meth:`states_reason` None) with the voltages ``v_steps`` (V
+        per step) from rest at ``initial_curvature`` (1/m), sampled every step, its samples
+        read from the states ``mujoco.rollout`` returns (one call, no Python per step; the
+        beam's points by :func:`mjeap.model.chain.chain_kinematics`, the drive's signals by
+        its ``native_signal_history``) into ``samples`` (n + 1 planned; the store the
+        native engine's run fills); with ``tip_only`` the tip alone, a :class:`TipPath`
+        (what an accuracy target's companion reads), returned. Raises :class:`StatesUnread`
+        where the chain's kinematics do not apply or the run goes bad (not finite, beyond
+        mjMAXVAL, or MuJoCo warned): the ordinary run then says why. The scene is left as
+        it was."""
+        native = scene.native_model(drive)
+        m, d, part = native.model, native.data, native.part
+        dt, n = scene.timestep, len(v_steps)
+        native.reset(initial_curvature)
+        state0 = np.empty(mujoco.mj_stateSize(m, STATE))
+        mujoco.mj_getState(m, d, state0, STATE)
+        control = np.empty(mujoco.mj_stateSize(m, NATIVE_CONTROL))
+        mujoco.mj_getState(m, d, control, NATIVE_CONTROL)
+        drive.native_prepare(v_steps)
+        ctl = np.broadcast_to(control, (1, n, len(control))).copy()
+        ctl[0, :, native.actuator_id] = v_steps
+        states, _ = mj_rollout.rollout(m, d, state0[None], ctl, control_spec=NATIVE_CONTROL, nstep=n)
+        if not (np.abs(states[0, :, 1:]) < MAXVAL).all() or not (np.diff(states[0, :, 0]) > 0).all() or \
+                d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number:
+            raise StatesUnread("the run went bad")
+        rows = np.concatenate([state0[None], states[0]])
+        steps = np.arange(n + 1)
+        if tip_only:
+            kin = chain_kinematics(m, rows[:, 1:1 + m.nq], [part.clamp_id, part.tip_body_id], part.tip_body_id)
+            if kin is None:
+                raise StatesUnread("the beam's bodies move otherwise than a planar hinge chain")
+            pos, rot = kin
+            site = pos[:, 1] + rot @ m.site_pos[part.tip_site_id]
+            return TipPath(steps * dt, part.clamp_frame(site - pos[:, 0]))
+        sig = drive.native_signal_history(steps, rows, part, native.handles)
+        bodies = [part.clamp_id, *part.link_ids, part.tip_body_id] + ([part.payload_id] if part.payload_id >= 0
+                                                                        else [])
+        kin = chain_kinematics(m, rows[:, 1:1 + m.nq], bodies, part.tip_body_id)
+        if sig is None or kin is None:
+            raise StatesUnread("the drive's signals or the beam's kinematics cannot be read from the states")
+        pos, rot = kin
+        N = len(part.link_ids)
+        site = pos[:, N + 1] + rot @ m.site_pos[part.tip_site_id]
+        raw = np.concatenate([pos[:, :N + 1], site[:, None]] + ([pos[:, N + 2:]] if part.payload_id >= 0 else []),
+                             axis=1)
+        samples.take_all(steps * dt, np.r_[v_steps[0], v_steps], raw, rot.reshape(-1, 9), sig)
+        return None
 
 
 def run_native(scene, native, drives: Sequence, v_steps: Sequence[np.ndarray], initial_curvatures: Sequence[float],

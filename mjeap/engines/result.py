@@ -1,17 +1,20 @@
-"""The result of a rollout: one actuator's sampled SI arrays (:class:`RolloutResult`),
-what every engine's samples become (:meth:`mjeap.engines.frame.Samples.result`)."""
+"""The results of runs, what every engine's samples become: one actuator's sampled SI arrays
+(:class:`RolloutResult`, :meth:`mjeap.engines.frame.Samples.result`), a system's
+(:class:`SystemResult`: one RolloutResult per actuator and every body's pose) and a run's
+tip alone (:class:`TipPath`, what an accuracy target's companion runs give its metrics)."""
 from __future__ import annotations
 
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Dict, Optional, Union
+from typing import Dict, List, Optional, Union
 
 import numpy as np
 
+from ..errors import UnknownNameError
 from ..io import csvio
 from ..io.outputs import replacing
 
-__all__ = ["RolloutResult"]
+__all__ = ["RolloutResult", "SystemResult", "TipPath"]
 
 
 @dataclass
@@ -50,3 +53,34 @@ class RolloutResult:
             w = csvio.writer(fh)
             w.writerow(cols)
             w.writerows(np.column_stack([np.asarray(c, dtype=float) for c in cols.values()]))
+
+
+@dataclass
+class SystemResult:
+    """A system rollout, SI: one :class:`RolloutResult` per actuator (by prefix, positions in
+    its own clamp frame) and every body's world pose per sample."""
+
+    time: np.ndarray                                  # (n,) s
+    actuators: Dict[str, object]                      # prefix -> RolloutResult
+    body_names: List[str]
+    body_position: np.ndarray                         # (n, nbody, 3) m, world
+    body_quat: np.ndarray                             # (n, nbody, 4) world (w x y z)
+    contact_force: np.ndarray                         # (n, nbody, 3) N, net contact force on each body, world
+    meta: dict = field(default_factory=dict)
+
+    def body(self, name: str) -> int:
+        try:
+            return self.body_names.index(name)
+        except ValueError:
+            raise UnknownNameError("body", name, self.body_names) from None
+
+
+class TipPath:
+    """What a companion run gives the metrics: ``time`` (s), ``tip_position`` (n, 3; m,
+    clamp frame) and ``tip_curvature`` (1/m), read as a RolloutResult reads them."""
+
+    def __init__(self, time: np.ndarray, tip_position: np.ndarray, meta: Optional[dict] = None):
+        from ..model.analytical import arc_curvature
+        self.time, self.tip_position = time, tip_position
+        self.tip_curvature = arc_curvature(tip_position[:, 0], tip_position[:, 1])
+        self.meta = {} if meta is None else meta

@@ -58,7 +58,7 @@ sample)| / 3, combined in quadrature. Each run is sampled every step otherwise: 
 held over a step puts a square wave's peak one step after its switch, and a grid coarser
 than the step reads the models' peaks unequally (on thick-trilayer's length sweep that hid
 a 0.7 % error from the companions); such a run is read from the states ``mujoco.rollout``
-returns for all its steps (:func:`run_from_states`), not sampled from Python, and a
+returns for all its steps (the native engine's :meth:`~mjeap.engines.native.NativeEngine.read_states`), not sampled from Python, and a
 refinement reuses the runs already made (its 2 h companion is the last chosen run where it
 halves the step). Where a metric's estimate exceeds the target (or a boolean is undecided), the
 error model e = sqrt((a / N^2)^2 + (b h)^2) takes a and b from the measured parts and a finer
@@ -71,11 +71,9 @@ import time as _time
 from dataclasses import asdict
 from typing import Dict, List, Optional, Sequence
 
-import mujoco
 import numpy as np
-from mujoco import rollout as mj_rollout
 
-from ..caching import BoundedCache
+from ..engines.result import TipPath
 from ..errors import ParameterError
 from ..model.modes import modal_frequencies
 from .accuracy import (SAFETY, ErrorModel, Model, as_error_model, check_accuracy, check_targetable, choose_model,
@@ -83,7 +81,7 @@ from .accuracy import (SAFETY, ErrorModel, Model, as_error_model, check_accuracy
 
 __all__ = ["METRIC_SCALES", "check_metrics", "answerable", "relaxed_step_cap", "last_period",
            "peak_to_peak", "returns_margin", "metric_quantity", "metric_scale", "run_metrics_at_accuracy",
-           "chain_kinematics", "run_from_states", "TipPath", "reported_value"]
+           "reported_value"]
 
 #: the metrics a target may be put on, and the scale each one's error is relative to
 METRIC_SCALES = {"peak_to_peak": "swing", "returns": "margin", "max_stress_proxy": "value",
@@ -122,7 +120,7 @@ EXTRAPOLATION_ORDERS = (0.7, 1.4)
 #: column load, 70-82 mg at 25 ms against runs at 0.5 and 1 ms: 0.06-0.075 of it)
 EXTRAPOLATION_FLOOR = 0.1
 #: cost of a run of a model: RUN_OVERHEAD + steps x (c0 + c1 N) (us; this 2-core machine,
-#: the map's scene under 'discrete', read from its states (:func:`run_from_states`): building
+#: the map's scene under 'discrete', read from its states (the native engine's read_states): building
 #: a variant and its native model about 12 ms, a step of 8 segments 12-15 us, of 16 27-35 us)
 RUN_OVERHEAD_US = 15_000.0
 COST_PER_STEP = (1.0, 1.6)
@@ -261,170 +259,6 @@ def _relative(x: float, scale: float) -> float:
     return x / scale if scale > 0 else (0.0 if x == 0 else math.inf)
 
 
-# ---------------------------------------------------------------- a run read from its states
-def _hinge_rotations(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
-    """(n, 3, 3) rotations by ``angle`` (n,) rad about the unit ``axis`` (Rodrigues)."""
-    k = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
-    s, c = np.sin(angle)[:, None, None], np.cos(angle)[:, None, None]
-    return np.eye(3) + s * k + (1.0 - c) * (k @ k)
-
-
-_EYE = np.eye(3)
-
-
-#: the structure :func:`chain_kinematics` reads from a model, by (model, bodies, frame_of): a
-#: choice's runs and a map's amplitudes step the same native models. Oldest dropped past 128
-_CHAINS = BoundedCache("chain structures", max_entries=128, locked=True)
-
-
-def _chain_structure(model, bodies: tuple, frame_of: int):
-    """What :func:`chain_kinematics` needs of ``model`` (None where it does not apply)."""
-    nb = max(*bodies, frame_of) + 1
-    frames = [(np.eye(3), None)]                # per body: F, axis a (None: not rotating)
-    hinges = np.zeros((model.nq, nb))           # body b's angle: qpos @ hinges[:, b]
-    offsets = np.zeros((3, nb, 3))              # body b's offset from its parent: cos, sin, 1 terms
-    rotating = np.zeros(nb, bool)               # whether body b's parent frame rotates
-    above = np.eye(nb)                          # above[k, b]: k is b or one of its ancestors
-    for b in range(1, nb):
-        p, nj = model.body_parentid[b], model.body_jntnum[b]
-        f, a = frames[p]
-        v = model.body_pos[b]
-        above[:, b] += above[:, p]
-        hinges[:, b] = hinges[:, p]
-        if a is None:
-            offsets[2, b] = f @ v
-        else:
-            rotating[b] = True
-            axv = np.array([a[1] * v[2] - a[2] * v[1], a[2] * v[0] - a[0] * v[2], a[0] * v[1] - a[1] * v[0]])
-            fa_av = (f @ a) * (a @ v)
-            offsets[0, b], offsets[1, b], offsets[2, b] = f @ v - fa_av, f @ axv, fa_av
-        local = np.empty(9)
-        mujoco.mju_quat2Mat(local, model.body_quat[b])
-        local = local.reshape(3, 3)
-        if nj > 1:
-            return None
-        j = model.body_jntadr[b]
-        if nj and (model.jnt_type[j] != mujoco.mjtJoint.mjJNT_HINGE or np.any(model.jnt_pos[j])):
-            return None
-        if a is not None and (not np.abs(local - _EYE).max() <= 1e-15 or
-                              (nj and not np.array_equal(model.jnt_axis[j], a))):
-            return None
-        if nj:
-            hinges[model.jnt_qposadr[j], b] += 1.0
-            frames.append((f @ local, model.jnt_axis[j].copy()) if a is None else (f, a))
-        else:
-            frames.append((f @ local, None) if a is None else (f, a))
-    # only the bodies above those asked for (the world first): their angles and offsets
-    keep = np.nonzero(above[:, list(bodies) + [frame_of]].any(axis=1))[0]
-    where = np.full(nb, -1)
-    where[keep] = np.arange(len(keep))
-    parent = where[model.body_parentid[keep]]
-    return (hinges[:, keep], offsets[:, keep], rotating[keep], np.maximum(parent, 0), above[keep[1:]][:, list(bodies)],
-            int(where[frame_of]), frames[frame_of])
-
-
-def chain_kinematics(model, qpos: np.ndarray, bodies: Sequence[int], frame_of: int):
-    """World positions (n, B, 3) of ``bodies`` and orientation (n, 3, 3) of body ``frame_of`` for the joint
-    positions ``qpos`` (n, nq), all samples at once, down a planar chain: each body's frame
-    is a fixed rotation F times a rotation by the summed angle phi of the hinges above it
-    about their one axis, so a point v of a body sits at x + F (v cos phi + (a x v) sin phi
-    + a (a . v)(1 - cos phi)). The structure is read once per model (a pass over the bodies,
-    kept), then every body's angle (qpos times a 0/1 matrix) and the positions (their
-    ancestors' offsets summed, one matrix product) for all samples together. None where a
-    body moves otherwise (a joint other than one hinge through its origin, hinges on
-    different axes, a rotated body below a hinge)."""
-    key = (tuple(int(b) for b in bodies), int(frame_of))
-    structure = _CHAINS.get_or_build(key, lambda: (_chain_structure(model, *key),), owner=model)[0]
-    if structure is None:
-        return None
-    hinges, offsets, rotating, parent, picked, frame_at, (f, a) = structure
-    n = len(qpos)
-    phi = qpos @ hinges                         # (n, nb): each body's summed hinge angle
-    c, s = np.cos(phi), np.sin(phi)
-    cp = np.where(rotating, c[:, parent], 1.0)
-    sp = np.where(rotating, s[:, parent], 0.0)
-    step = cp[:, :, None] * offsets[0] + sp[:, :, None] * offsets[1] + offsets[2]      # (n, nb, 3)
-    nb = step.shape[1]
-    pos = (step[:, 1:].transpose(0, 2, 1).reshape(3 * n, nb - 1) @ picked).reshape(n, 3, -1).transpose(0, 2, 1)
-    return pos, np.broadcast_to(f, (n, 3, 3)) if a is None else f @ _hinge_rotations(a, phi[:, frame_at])
-
-
-class TipPath:
-    """What a companion run gives the metrics: ``time`` (s), ``tip_position`` (n, 3; m,
-    clamp frame) and ``tip_curvature`` (1/m), read as a RolloutResult reads them."""
-
-    def __init__(self, time: np.ndarray, tip_position: np.ndarray):
-        from ..model.analytical import arc_curvature
-        self.time, self.tip_position = time, tip_position
-        self.tip_curvature = arc_curvature(tip_position[:, 0], tip_position[:, 1])
-
-
-def run_from_states(scene, drive, wave, duration: float, initial_curvature: float = 0.0, tip_only: bool = False):
-    """One native run of ``scene`` sampled at every step, its samples read from the states
-    ``mujoco.rollout`` returns (one call, no Python per step; the beam's points by
-    :func:`chain_kinematics`, the drive's signals by its ``native_signal_history``): the
-    RolloutResult the native engine gives sampled every step, at a fraction of the cost
-    (``tip_only``: a :class:`TipPath`, the tip alone, what a companion's metrics read). None
-    where that does not apply (no native form, a moving clamp, tip loads, a drive reading
-    its signals one sample at a time, joints other than hinges) or where the run goes bad
-    (the caller then runs it the ordinary way, which says why)."""
-    from ..engines.frame import Samples, voltage_steps
-    from ..engines.native import why_not
-    from ..drives.base import NativeForm
-    from ..engines.threaded import MAXVAL, NATIVE_CONTROL, STATE
-    from ..io.outputs import provenance
-    if why_not(scene, drive) is not None or scene.part.has_tip_load() or \
-            type(drive).native_signal_history is NativeForm.native_signal_history:
-        return None
-    t0 = _time.perf_counter()
-    native = scene.native_model(drive)
-    m, d, part = native.model, native.data, native.part
-    dt = scene.timestep
-    v = voltage_steps(wave, duration, dt, drive)
-    n = len(v)
-    native.reset(initial_curvature)
-    state0 = np.empty(mujoco.mj_stateSize(m, STATE))
-    mujoco.mj_getState(m, d, state0, STATE)
-    control = np.empty(mujoco.mj_stateSize(m, NATIVE_CONTROL))
-    mujoco.mj_getState(m, d, control, NATIVE_CONTROL)
-    drive.native_prepare(v)
-    ctl = np.broadcast_to(control, (1, n, len(control))).copy()
-    ctl[0, :, native.actuator_id] = v
-    states, _ = mj_rollout.rollout(m, d, state0[None], ctl, control_spec=NATIVE_CONTROL, nstep=n)
-    # bad: not finite or beyond mjMAXVAL, or a step on which MuJoCo warned (time stops)
-    if not (np.abs(states[0, :, 1:]) < MAXVAL).all() or not (np.diff(states[0, :, 0]) > 0).all() or \
-            d.warning[mujoco.mjtWarning.mjWARN_BADQACC].number:
-        return None
-    rows = np.concatenate([state0[None], states[0]])
-    steps = np.arange(n + 1)
-    if tip_only:
-        kin = chain_kinematics(m, rows[:, 1:1 + m.nq], [part.clamp_id, part.tip_body_id], part.tip_body_id)
-        if kin is None:
-            return None
-        pos, rot = kin
-        site = pos[:, 1] + rot @ m.site_pos[part.tip_site_id]
-        return TipPath(steps * dt, part.clamp_frame(site - pos[:, 0]))
-    sig = drive.native_signal_history(steps, rows, part, native.handles)
-    bodies = [part.clamp_id, *part.link_ids, part.tip_body_id] + ([part.payload_id] if part.payload_id >= 0 else [])
-    kin = chain_kinematics(m, rows[:, 1:1 + m.nq], bodies, part.tip_body_id)
-    if sig is None or kin is None:
-        return None
-    pos, rot = kin
-    N = len(part.link_ids)
-    site = pos[:, N + 1] + rot @ m.site_pos[part.tip_site_id]
-    raw = np.concatenate([pos[:, :N + 1], site[:, None]] + ([pos[:, N + 2:]] if part.payload_id >= 0 else []), axis=1)
-    samples = Samples(part, n + 1)
-    samples.take_all(steps * dt, np.r_[v[0], v], raw, rot.reshape(-1, 9), sig)
-    meta = {**provenance(), "actuator": scene.actuator.id, "drive": drive.describe(),
-            "voltage": getattr(wave, "text", str(wave)), "duration_s": duration,
-            "initial_curvature_per_m": initial_curvature, "steps": n,
-            "engine": "native (every step read from mujoco.rollout's states)", "scene": scene.summary(),
-            "wall_time_s": _time.perf_counter() - t0}
-    if scene.choice.buckled:
-        meta["warnings"] = [scene.buckled_warning()]
-    return samples.result(drive, initial_curvature, meta)
-
-
 # ---------------------------------------------------------------- the choice
 def _cost(model: Model, duration: float) -> float:
     c0, c1 = COST_PER_STEP
@@ -541,13 +375,13 @@ def _needs(metrics: Dict[str, dict], target: float) -> float:
 
 
 def run_metrics_at_accuracy(scene, run, *, metrics: Sequence[str], accuracy: float, duration: float, drive,
-                            wave=None, sample_interval: Optional[float] = None, error_model=None, every_step=None):
+                            wave=None, sample_interval: Optional[float] = None, error_model=None):
     """Choose, run and check a model of ``scene`` whose ``metrics`` (names of
-    :data:`METRIC_SCALES`) are within ``accuracy`` of their scales. ``run(scene, interval)``
-    runs one model sampled every ``interval`` s (None: every step) and returns a
-    RolloutResult; ``every_step(scene, tip_only)``, where given, runs one sampled every step
-    the faster way (:func:`run_from_states`; the companions ``tip_only``; None where that does
-    not apply: ``run`` then runs it);
+    :data:`METRIC_SCALES`) are within ``accuracy`` of their scales. ``run(scene, interval,
+    every_step=False, tip_only=False)`` runs one model sampled every ``interval`` s (None:
+    every step) and returns a RolloutResult; with ``every_step`` (sampled every step) read
+    from its states where the native engine can (:meth:`mjeap.engines.native.NativeEngine.read_states`;
+    the companions ``tip_only``: a :class:`~mjeap.engines.result.TipPath`);
     ``drive`` (the question's drive) bounds the relaxed step. ``error_model``:
     (a, b) of a similar question (a sweep's earlier point) choosing the first model. Returns
     (result, scene of the chosen model, report), the report also in
@@ -583,9 +417,7 @@ def run_metrics_at_accuracy(scene, run, *, metrics: Sequence[str], accuracy: flo
             return done[model, interval]
         s = scene.variant(model.segments, model.timestep, model.integrator)
         t = _time.perf_counter()
-        out = every_step(s, tip_only) if every_step is not None and interval == model.timestep else None
-        if out is None:
-            out = run(s, interval)
+        out = run(s, interval, every_step=interval == model.timestep, tip_only=tip_only)
         log.append({"role": role, **asdict(model), "wall_time_s": _time.perf_counter() - t})
         done[model, interval] = s, out
         return s, out

@@ -13,15 +13,15 @@ from typing import List, Optional, Sequence, Union
 
 import numpy as np
 
+from . import pipeline
 from .accuracy import GRID_SAMPLES, target_for
-from ..engines import ENGINES, choose, run_checked
-from .periodic import MIN_SAMPLES_PER_PERIOD, PeriodicStop, check_periodic_stop
+from ..engines import ENGINES
+from .periodic import check_periodic_stop
 from ..engines.frame import (DEFAULT_SAMPLES, MAX_INITIAL_BEND, MAX_STEPS, check_controller, check_initial_curvature,
                              check_sampling, check_work, one_voltage, to_waveform)
 from ..engines.result import RolloutResult
 from ..errors import ParameterError, check_integer, check_positive
 from ..io.outputs import check_outputs, guarded, write_outputs
-from .pipeline import execute, plan, write_run
 from .scene import Scene
 from ..drives.waveforms import Waveform
 
@@ -39,17 +39,8 @@ def check_stop(stop_when_periodic, wave, duration: float, sample_interval: Optio
                                duration / (GRID_SAMPLES if at_accuracy else DEFAULT_SAMPLES))
 
 
-def _meta(scene, drv, wave, duration, initial_curvature) -> dict:
-    """What a scene's run describes in its meta (:func:`mjeap.simulation.pipeline.plan` adds
-    the provenance, steps and engine)."""
-    return {"actuator": scene.actuator.id, "drive": drv.describe(),
-            "voltage": "closed loop" if wave is None else getattr(wave, "text", str(wave)),
-            "duration_s": duration, "initial_curvature_per_m": initial_curvature, "scene": scene.summary(),
-            "drive_parameters": {k: [v, drv.sources.get(k, "")] for k, v in drv.params.items()}}
-
-
 @guarded("rrd", "csv_path")
-def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: float,
+def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: float, *,
             drive: Union[str, "object", None] = None, drive_params: Optional[dict] = None,
             initial_curvature: float = 0.0, rrd: Union[str, Path, None] = None,
             csv_path: Union[str, Path, None] = None, sample_interval: Optional[float] = None,
@@ -105,72 +96,20 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     if metrics is not None:
         from .metric_accuracy import check_metrics
         metrics = check_metrics(metrics)
-    if error_model is not None:         # its values are checked by run_at_accuracy, before any run
-        if target is None:
-            raise ParameterError("error_model", error_model, "None without an accuracy target (it chooses the model "
-                                 "for one)")
+    if error_model is not None and target is None:      # its values are checked by the choice, before any run
+        raise ParameterError("error_model", error_model, "None without an accuracy target (it chooses the model for "
+                             "one)")
     if stop_when_periodic is not None:         # checked before any work, on the sampling the run will have
-        stop_tol, period = check_stop(stop_when_periodic, wave, duration, sample_interval,
-                                      target is not None or estimate_error)
+        check_stop(stop_when_periodic, wave, duration, sample_interval, target is not None or estimate_error)
     if target is not None or estimate_error:
         scene.part.check_derivable()
-        return _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, csv_path, sample_interval,
-                                    check_every, controller, engine, max_steps, target, wave, error_model,
-                                    stop_when_periodic, metrics)
-    eng, engine_reason = choose(engine, scene, drv, controller)
-    p = plan(eng, engine_reason, [wave], [drv], lambda: [eng.part(scene, drv)], duration, scene.timestep,
-             sample_interval, _meta(scene, drv, wave, duration, initial_curvature), max_steps=max_steps)
-    (samples,) = p.samples
-    if stop_when_periodic is not None:
-        samples.stop = PeriodicStop(period, stop_tol, scene.layout.length)
-    if scene.choice.buckled:
-        p.meta.setdefault("warnings", []).append(scene.buckled_warning())
-    if controller is not None:
-        p.meta["controller"] = ctrl_name
-    return execute(p.meta, lambda: run_checked(eng, scene, [drv], p.v_steps, [initial_curvature], p.sample_steps,
-                                               p.samples, progress=progress, check_every=check_every,
-                                               controller=controller, meta=p.meta),
-                   lambda error: samples.result(drv, initial_curvature, p.meta),
-                   lambda result, error: write_run(result, scene, rrd, csv_path, error))
-
-
-def _rollout_at_accuracy(scene, voltage, duration, drv, initial_curvature, rrd, csv_path, sample_interval,
-                         check_every, controller, engine, max_steps, target, wave, error_model=None,
-                         stop_when_periodic=None, metrics=None) -> RolloutResult:
-    """:func:`rollout` at an accuracy target (or, without one, with its error estimated): the
-    runs of :mod:`mjeap.simulation.accuracy`, each with the drive ``drv`` names and its parameters;
-    the outputs hold the chosen run, whose meta says how it was chosen."""
-    from . import accuracy as acc
     params = dict(drv.params)
-
-    def run(s, interval):
-        # each run stops on its own where its sampling allows (the estimate compares the runs
-        # over the instants they share); a companion sampled coarser runs to the end
-        stop = stop_when_periodic if stop_when_periodic is not None and \
-            (interval or duration / DEFAULT_SAMPLES) * wave.frequency <= 1.0 / MIN_SAMPLES_PER_PERIOD else None
-        return rollout(s, voltage, duration, drive=type(drv)(s, **params),
-                       initial_curvature=initial_curvature, sample_interval=interval, progress=False,
-                       check_every=check_every, controller=controller, engine=engine, max_steps=max_steps,
-                       stop_when_periodic=stop)
-
-    if target is not None and metrics:
-        from .metric_accuracy import run_from_states, run_metrics_at_accuracy
-        every_step = None       # each run sampled every step, read from its states where that applies
-        if controller is None and engine in ("auto", "native") and stop_when_periodic is None and max_steps is None:
-            def every_step(s, tip_only=False):
-                return run_from_states(s, type(drv)(s, **params), wave, duration, initial_curvature, tip_only)
-        result, chosen, _ = run_metrics_at_accuracy(scene, run, metrics=metrics, accuracy=target, duration=duration,
-                                                    drive=drv, wave=wave, sample_interval=sample_interval,
-                                                    error_model=error_model, every_step=every_step)
-    elif target is None:
-        chosen = scene
-        result = run(scene, sample_interval)
-        acc.estimate_error(scene, run, result, duration=duration, sample_interval=sample_interval)
-    else:
-        result, chosen, _ = acc.run_at_accuracy(scene, run, accuracy=target, duration=duration, wave=wave,
-                                                sample_interval=sample_interval, error_model=error_model)
-    write_run(result, chosen, rrd, csv_path)
-    return result
+    return pipeline.run(pipeline.Job(
+        scene, (wave,), (drv,), duration, (initial_curvature,), make_drives=lambda s: (type(drv)(s, **params),),
+        sample_interval=sample_interval, engine=engine, controller=controller, controller_name=ctrl_name,
+        max_steps=max_steps, progress=progress, check_every=check_every, stop_when_periodic=stop_when_periodic,
+        accuracy=target, metrics=metrics, error_model=error_model, estimate_error=estimate_error, rrd=rrd,
+        csv_path=csv_path))
 
 
 def free_vibration(scene: Scene, curvature: float, duration: float, **kw) -> RolloutResult:
@@ -180,7 +119,7 @@ def free_vibration(scene: Scene, curvature: float, duration: float, **kw) -> Rol
     return rollout(scene, "step:0V", duration, drive="none", initial_curvature=curvature, **kw)
 
 
-def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable]], duration: float,
+def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable]], duration: float, *,
                   drive: Optional[str] = None, drive_params: Optional[dict] = None,
                   initial_curvatures: Union[float, Sequence[float]] = 0.0,
                   sample_interval: Optional[float] = None, nthread: Optional[int] = None,
@@ -223,32 +162,12 @@ def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable
     if metrics is not None:
         from .metric_accuracy import check_metrics
         metrics = check_metrics(metrics)
-    if target is not None and metrics is not None:       # each member's own model for its answer
-        return [rollout(scene, v, duration, drive=drive, drive_params=drive_params, initial_curvature=k,
-                        sample_interval=sample_interval, progress=False, engine=engine, accuracy=target,
-                        metrics=metrics) for v, k in zip(voltages, kappa0)]
     if target is not None:
-        from .accuracy import run_at_accuracy
         scene.part.check_derivable()
-        waves = [to_waveform(v, duration) for v in voltages]
-        fastest = max(waves, key=lambda w: getattr(w, "max_frequency", 0.0) or 0.0)
-        make_drive(drive, scene, **(drive_params or {}))          # the drive's parameters, checked first
-
-        def run(s, interval, members=slice(None)):
-            return rollout_batch(s, voltages[members], duration, drive=drive, drive_params=drive_params,
-                                 initial_curvatures=kappa0[members], sample_interval=interval, nthread=nthread,
-                                 engine=engine)
-        return run_at_accuracy(scene, run, accuracy=target, duration=duration, wave=fastest,
-                               sample_interval=sample_interval,
-                               pilot_run=(lambda s, i: run(s, i, slice(1))) if len(voltages) > 1 else None)[0]
-    drives = [make_drive(drive, scene, **(drive_params or {})) for _ in voltages]
-    eng, engine_reason = choose(engine, scene, drives[0], None, batched=True)
-    waves = [to_waveform(v, duration) for v in voltages]
-    engine_meta: dict = {}              # what the engine says of its run (the warp engine's settings)
-    p = plan(eng, engine_reason, waves, drives, lambda: [eng.part(scene, drives[0])] * len(voltages), duration,
-             scene.timestep, sample_interval, {"batch": len(voltages), "nthread": nthread})
-    return execute(p.meta, lambda: run_checked(eng, scene, drives, p.v_steps, list(kappa0), p.sample_steps,
-                                               p.samples, nthread=nthread, meta=engine_meta),
-                   lambda error: None if error is not None else
-                   [smp.result(d, float(k0), {**p.meta, **_meta(scene, d, w, duration, float(k0)), **engine_meta})
-                    for w, d, k0, smp in zip(waves, drives, kappa0, p.samples)])
+    waves = tuple(to_waveform(v, duration) for v in voltages)
+    params = drive_params or {}
+    drives = tuple(make_drive(drive, scene, **params) for _ in voltages)     # the drive's parameters, checked first
+    return pipeline.run(pipeline.Job(
+        scene, waves, drives, duration, tuple(kappa0),
+        make_drives=lambda s: tuple(make_drive(drive, s, **params) for _ in voltages), sample_interval=sample_interval,
+        engine=engine, batch=True, nthread=nthread, accuracy=target, metrics=metrics if target is not None else None))

@@ -33,6 +33,7 @@ from ..errors import DivergenceError, ParameterError, UnknownNameError, check_po
 from ..io.outputs import guarded
 from ..versions import newton_sparse_broken
 from ..engines.frame import check_work, one_voltage
+from ..engines.result import SystemResult
 from ..engines.native import why_not as native_why_not
 from ..model.fields import UNITS_FIELD, add_units, apply_dof_damping
 from .scene import DEFAULT_SEGMENTS, INTEGRATORS, Scene, diverged
@@ -364,26 +365,6 @@ def add_transmission(spec: mujoco.MjSpec, actuator: AttachedActuator, joint: str
     eq.data[:5] = [0.0, ratio * u.length, 0.0, 0.0, 0.0]
 
 
-@dataclass
-class SystemResult:
-    """A system rollout, SI: one :class:`~mjeap.simulation.rollout.RolloutResult` per actuator (by
-    prefix, positions in its own clamp frame) and every body's world pose per sample."""
-
-    time: np.ndarray                                  # (n,) s
-    actuators: Dict[str, object]                      # prefix -> RolloutResult
-    body_names: List[str]
-    body_position: np.ndarray                         # (n, nbody, 3) m, world
-    body_quat: np.ndarray                             # (n, nbody, 4) world (w x y z)
-    contact_force: np.ndarray                         # (n, nbody, 3) N, net contact force on each body, world
-    meta: dict = field(default_factory=dict)
-
-    def body(self, name: str) -> int:
-        try:
-            return self.body_names.index(name)
-        except ValueError:
-            raise UnknownNameError("body", name, self.body_names) from None
-
-
 class System:
     """A compiled MuJoCo system: a host ``spec`` with ``actuators`` attached by
     :func:`attach` (all in ``units``), other bodies, joints, constraints and contact.
@@ -610,7 +591,7 @@ class System:
         dist = [d.contact[i].dist for i in range(d.ncon)]
         return max(0.0, -min(dist, default=0.0)) * self.units.length
 
-    def _control(self, voltages, v_steps, k: int, who: str) -> None:
+    def hold_voltages(self, voltages, v_steps, k: int, who: str) -> None:
         """Hold a controller's ``voltages`` (V) from step ``k`` on, each checked first: one
         number per actuator (or one for all, or a dict by prefix; None: unchanged)."""
         t = self.time
@@ -641,7 +622,7 @@ class System:
 
     # ------------------------------------------------------------------ rollout
     @guarded("rrd")
-    def rollout(self, voltages, duration: float, initial_curvatures: Union[float, Sequence[float]] = 0.0,
+    def rollout(self, voltages, duration: float, *, initial_curvatures: Union[float, Sequence[float]] = 0.0,
                 sample_interval: Optional[float] = None, rrd: Union[str, Path, None] = None,
                 on_sample=None, controller=None, engine: str = "auto", estimate_error: bool = False) -> SystemResult:
         """Run for ``duration`` s with one voltage per actuator (waveform text,
@@ -661,9 +642,8 @@ class System:
         ``estimate_error``: each actuator's tip-curvature error from the timestep, against the
         system at half the step (:func:`mjeap.simulation.accuracy.estimate_system_error`; 2 x
         the cost; open loop without ``on_sample``), in ``meta['accuracy']``."""
-        from ..engines import choose_system
         from ..engines.frame import check_controller, to_waveform
-        from .pipeline import execute, plan, write_run
+        from . import pipeline
         duration = check_positive("duration", duration, "s")
         ctrl_name = None if controller is None else check_controller(controller)
         if estimate_error and (controller is not None or on_sample is not None):
@@ -673,7 +653,6 @@ class System:
         if estimate_error:
             for p in self.parts:
                 p.check_derivable()
-        eng, engine_reason = choose_system(engine, self, controller, on_sample)
         if controller is not None:
             if voltages is not None and any(v is not None for v in self._per_actuator("voltages", voltages)):
                 raise ParameterError("voltages", voltages, "None when a controller sets the voltages")
@@ -683,22 +662,13 @@ class System:
         for a, w in zip(self.actuators, waves):
             if a.drive is None and w is not None:
                 raise ParameterError("voltages", getattr(w, "text", w), f"None for the passive actuator '{a.prefix}'")
-        # a waveform is checked against the drive's safe range; the rest voltage (None) is in it
-        p = plan(eng, engine_reason, waves, [a.drive for a in self.actuators], self.parts, duration, self.timestep,
-                 sample_interval, self._describe(waves, controller, ctrl_name, duration), remedy=SYSTEM_TIMESTEP,
-                 rest=True)
-        run, finish = self._stepping(p, initial_curvatures, on_sample, controller, ctrl_name)
+        # a waveform is checked against the drive's safe range (the plan); the rest voltage (None) is in it
+        return pipeline.run(pipeline.Job(
+            self, tuple(waves), tuple(a.drive for a in self.actuators), duration, initial_curvatures,
+            sample_interval=sample_interval, engine=engine, controller=controller, controller_name=ctrl_name,
+            on_sample=on_sample, estimate_error=estimate_error, remedy=SYSTEM_TIMESTEP, rrd=rrd))
 
-        def finish_estimated(error):
-            res = finish()
-            if estimate_error and error is None:
-                from .accuracy import estimate_system_error
-                estimate_system_error(self, res, lambda comp, interval: comp.rollout(
-                    voltages, duration, initial_curvatures, sample_interval=interval, engine=engine))
-            return res
-        return execute(p.meta, run, finish_estimated, lambda res, error: write_run(res, self, rrd, error=error))
-
-    def _describe(self, waves, controller, ctrl_name, duration: float) -> dict:
+    def describe_run(self, waves, controller, ctrl_name: Optional[str], duration: float) -> dict:
         """What a run of this system describes in its meta (:func:`mjeap.simulation.pipeline.plan`
         adds the provenance, steps and engine)."""
         return {"actuators": {a.prefix.rstrip("/"): {"actuator": a.twin.actuator.id,
@@ -709,85 +679,6 @@ class System:
                               for a, w in zip(self.actuators, waves)},
                 "duration_s": duration, "timestep_s": self.timestep, "timestep_reason": self.timestep_reason,
                 "units": self.units.describe()}
-
-    def _stepping(self, plan, initial_curvatures, on_sample, controller, ctrl_name):
-        """The system's side of a planned run (:mod:`mjeap.simulation.pipeline`), from its reset
-        state: (run, finish): ``run()`` steps it on the plan's engine (the ctrl held over each
-        step, a controller's voltages, the samples with the bodies' poses and contact forces);
-        ``finish()`` the :class:`SystemResult` of the samples taken."""
-        from ..engines import run_system_checked
-        from ..engines.frame import controller_every, reset_controller
-        eng, n_steps, sample_steps, v_steps, samples = (plan.engine, plan.n_steps, plan.sample_steps, plan.v_steps,
-                                                        plan.samples)
-        dt, ns = self.timestep, len(sample_steps)
-        nb = self.model.nbody
-        pos, quat, fc = np.empty((ns, nb, 3)), np.empty((ns, nb, 4)), np.empty((ns, nb, 3))
-        m, d = self.model, self.data
-        self.reset(initial_curvatures)
-        for a, v in zip(self.actuators, v_steps):
-            if v is not None:
-                a.drive.native_prepare(v, dt)
-        active = [(i, v) for i, v in zip(self.actuator_ids, v_steps) if v is not None]
-        ws = np.empty(m.nv)
-        # the state before each sampled step: a drive's signals replay that step from it
-        # (the piezo bimorph's motional current is at the held voltage's instant)
-        full = mujoco.mjtState.mjSTATE_FULLPHYSICS
-        pre = np.empty(mujoco.mj_stateSize(m, full))
-        sampled = np.zeros(n_steps + 1, dtype=bool)
-        sampled[sample_steps] = True
-        ctrl_every = 1
-
-        def sample(i, k):
-            ws[:] = d.qacc_warmstart
-            mujoco.mj_forward(m, d)             # contacts and their forces at this state
-            d.qacc_warmstart[:] = ws
-            for a, p, smp, v in zip(self.actuators, self.parts, samples, v_steps):
-                sig = {} if a.drive is None else a.drive.native_signals(k, p, a.native, a.prefix,
-                                                                        before=pre if k else None)
-                smp.take(k * dt, np.nan if v is None else v[max(k - 1, 0)], sig)
-            pos[i] = d.xpos * self.units.length
-            quat[i] = d.xquat
-            fc[i] = self.contact_forces()
-            if on_sample is not None:
-                on_sample(self)
-
-        def before(k):
-            if controller is not None and k:
-                if k % ctrl_every == 0:
-                    self._control(controller(k * dt, self), v_steps, k, ctrl_name)
-                else:                           # held between the controller's calls
-                    for vs in v_steps:
-                        if vs is not None:
-                            vs[k] = vs[k - 1]
-            for i, v in active:
-                d.ctrl[i] = v[k]
-            if sampled[k + 1]:
-                mujoco.mj_getState(m, d, pre, full)
-
-        def check(done, k):
-            self.step_count = done
-            self.check_finite()
-
-        def run():
-            nonlocal ctrl_every
-            if controller is not None:          # the voltage over step 0 is the first sample's
-                reset_controller(controller, self, None)
-                ctrl_every = controller_every(controller, dt)
-                self._control(controller(0.0, self), v_steps, 0, ctrl_name)
-            run_system_checked(eng, self, n_steps, sample_steps, before, sample, check)
-            self.step_count = n_steps
-
-        def finish():
-            n = samples[0].n if samples else 0
-            results = {}
-            for a, smp in zip(self.actuators, samples):
-                r = smp.result(a.drive, 0.0, dict(plan.meta))
-                r.reference_curvature = None if a.drive is None else r.reference_curvature
-                results[a.prefix.rstrip("/")] = r
-            names = [mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_BODY, b) or f"body{b}" for b in range(nb)]
-            return SystemResult(samples[0].t[:n] if samples else np.zeros(0), results, names, pos[:n], quat[:n],
-                                fc[:n], plan.meta)
-        return run, finish
 
     def half_step(self) -> "System":
         """This system at half its timestep: a copy of its spec with the same actuators,

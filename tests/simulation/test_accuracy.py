@@ -94,17 +94,18 @@ def test_batch_at_a_target_shares_one_model_and_estimates_each():
 def test_batch_pilots_run_on_its_first_member_and_each_member_is_measured(monkeypatch):
     """The pilots run once, on the first member; the segments' error of every member is then
     measured on it (a companion of N / sqrt 2 segments), not taken from the pilots' a."""
-    import mjeap.simulation.rollout as ro
+    from mjeap import rollout_batch
+    from mjeap.simulation import pipeline
     sizes = []
-    real = ro.rollout_batch
+    real = pipeline.run
 
-    def counting(scene, voltages, *a, **kw):
-        if kw.get("accuracy") is None and scene.chosen_model:
-            sizes.append(len(voltages))
-        return real(scene, voltages, *a, **kw)
-    monkeypatch.setattr(ro, "rollout_batch", counting)
+    def counting(job):          # the model runs come back through the pipeline's one entry
+        if job.batch and job.accuracy is None and job.target.chosen_model:
+            sizes.append(len(job.waves))
+        return real(job)
+    monkeypatch.setattr(pipeline, "run", counting)
     s = Scene("pedot-micro", **FAST)
-    rs = real(s, ["sine:0.5V@5Hz", "sine:1.0V@5Hz", "sine:1.5V@5Hz"], 0.2, nthread=1, accuracy=3e-3)
+    rs = rollout_batch(s, ["sine:0.5V@5Hz", "sine:1.0V@5Hz", "sine:1.5V@5Hz"], 0.2, nthread=1, accuracy=3e-3)
     roles = [x["role"] for x in rs[0].meta["accuracy"]["runs"]]
     assert roles.count("pilot") == 3 and "spatial companion" in roles
     assert sizes[:3] == [1, 1, 1] and all(n == 3 for n in sizes[3:])

@@ -10,7 +10,8 @@ import pytest
 from mjeap import Scene, rollout
 from mjeap.drives import make_drive
 from mjeap.errors import ParameterError
-from mjeap.simulation.metric_accuracy import check_metrics, relaxed_step_cap, run_from_states
+from mjeap.simulation import pipeline
+from mjeap.simulation.metric_accuracy import check_metrics, relaxed_step_cap
 from mjeap.engines.frame import to_waveform
 
 GOLDEN = Path(__file__).resolve().parents[1] / "golden" / "metric_accuracy.json"
@@ -111,13 +112,24 @@ def test_a_map_row_reports_the_extrapolated_answer(tmp_path):
     assert row["returns"] is (a["returns"]["value"] > 0)
 
 
+def read_from_states(s, wave, duration, tip_only=False):
+    """A run of ``s`` sampled every step, read from its states through the pipeline (the
+    native engine's mode a metric target's runs use)."""
+    job = pipeline.Job(s, (wave,), (make_drive(None, s),), duration, (0.0,), sample_interval=s.timestep,
+                       read_states=True, tip_only=tip_only)
+    out = pipeline.run(job)
+    assert tip_only or out.meta["engine"] == "native (every step read from mujoco.rollout's states)"
+    return out
+
+
 def test_companions_read_at_the_tip_equal_the_full_read():
     """A companion's run read at the tip alone (TipPath) gives the full read's time, tip
     position and tip curvature to round-off."""
     s = Scene("pedot-micro", orientation="up", payload="70mg@6.27mm").variant(8, 0.05, "discrete")
     wave = to_waveform("square:1V@0.1Hz", 20.0)
-    full = run_from_states(s, make_drive(None, s), wave, 20.0)
-    tip = run_from_states(s, make_drive(None, s), wave, 20.0, tip_only=True)
+    full = read_from_states(s, wave, 20.0)
+    tip = read_from_states(s, wave, 20.0, tip_only=True)
+    assert type(tip).__name__ == "TipPath"
     for k in ("time", "tip_position", "tip_curvature"):
         a, b = getattr(tip, k), getattr(full, k)
         assert a.shape == b.shape and np.max(np.abs(a - b)) <= 1e-12 * np.max(np.abs(b)), k
@@ -208,7 +220,7 @@ def test_runs_read_from_their_states_equal_the_native_engines_samples():
     assert s.choice.buckled
     ref = rollout(s, "square:1.5V@1Hz", 3.0, drive=make_drive(None, s), sample_interval=0.025, engine="native",
                   progress=False)
-    got = run_from_states(s, make_drive(None, s), to_waveform("square:1.5V@1Hz", 3.0), 3.0)
+    got = read_from_states(s, to_waveform("square:1.5V@1Hz", 3.0), 3.0)
     assert got is not None and len(got.time) == len(ref.time) == 121
     for k in ("time", "voltage", "tip_position", "tip_angle", "tip_curvature", "centreline", "payload_position"):
         a, b = getattr(got, k), getattr(ref, k)
