@@ -24,7 +24,7 @@ class CurvatureTracker:
 
     name = "curvature-tracker (inverse-model feedforward + PI)"
 
-    def __init__(self, reference: Callable, duration: float, plant=((63.0, 63.0 * 0.52), (1.0, 2.1, 0.54)),
+    def __init__(self, reference: Callable, duration: float, *, plant=((63.0, 63.0 * 0.52), (1.0, 2.1, 0.54)),
                  kp: float = 0.02, ki: float = 0.1, tau: float = 0.05, interval: float = 1e-3,
                  feedforward: bool = True, feedback: bool = True):
         self.reference, self.kp, self.ki, self.interval = reference, kp, ki, interval

@@ -242,7 +242,7 @@ def phase_errors_per_cycle(time, position, frequency: float, desired_phase: floa
     return np.degrees(out)
 
 
-def run_leg(transmission: Transmission = SWING, cycles: int = 40, open_loop_cycles: int = 10,
+def run_leg(transmission: Transmission = SWING, *, cycles: int = 40, open_loop_cycles: int = 10,
             bias: float = 100.0, amplitude: float = 20.0, frequency: float = 100.0,
             estimator: Optional[SelfSensingEstimator] = None, gains=None, rrd=None,
             timestep: Optional[float] = None) -> LegRun:

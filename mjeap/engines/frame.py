@@ -317,7 +317,7 @@ def sample_steps(n_steps: int, dt: float, sample_interval: Optional[float]) -> n
 
 
 def lockstep(model, data, n_steps: int, steps: np.ndarray, before: Callable[[int], None],
-             sample: Callable[[int, int], None], check: Callable[[int, int], None], check_every: int = 100,
+             sample: Callable[[int, int], None], check: Callable[[int, int], None], *, check_every: int = 100,
              progress: Optional[Callable[[int], None]] = None) -> None:
     """Step ``model`` ``n_steps`` times from Python, the frame of the loop engine and of
     :meth:`mjeap.System.rollout`: ``before(k)`` sets what acts over step k (a drive's

@@ -115,11 +115,11 @@ class LoopEngine(Engine):
     def run(self, scene, drives, v_steps, initial_curvatures, sample_steps, samples, *, nthread=0, progress=None,
             check_every=100, controller=None, meta=None) -> None:
         (drv,), (v,), (kappa0,), (store,) = drives, v_steps, initial_curvatures, samples
-        run_loop(scene, drv, v, kappa0, sample_steps, store, progress, check_every, controller,
-                 {} if meta is None else meta)
+        run_loop(scene, drv, v, kappa0, sample_steps, store, progress=progress, check_every=check_every,
+                 controller=controller, meta={} if meta is None else meta)
 
 
-def run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, progress, check_every,
+def run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, *, progress, check_every,
              controller, meta) -> None:
     """One lockstep run of ``scene`` with ``drv``: ``v_steps`` (V per step; a controller's
     commands are written into it), sampled at ``sample_steps`` into ``samples``."""
@@ -177,8 +177,8 @@ def run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, prog
         window[1] = done
 
     try:
-        lockstep(m, d, n_steps, sample_steps, open_loop if controller is None else closed_loop, sample, check, check_every,
-                 None if bar is None else bar.update)
+        lockstep(m, d, n_steps, sample_steps, open_loop if controller is None else closed_loop, sample, check,
+                 check_every=check_every, progress=None if bar is None else bar.update)
     finally:
         if bar is not None:
             bar.close()

@@ -118,7 +118,7 @@ class NativeEngine(Engine):
 
 
 def run_native(scene, native, drives: Sequence, v_steps: Sequence[np.ndarray], initial_curvatures: Sequence[float],
-               sample_steps: np.ndarray, samples: Sequence, nthread: int = 0, roller=roll) -> None:
+               sample_steps: np.ndarray, samples: Sequence, *, nthread: int = 0, roller=roll) -> None:
     """As :func:`run`, on the scene's native model (:class:`mjeap.simulation.native_model.NativeModel`): the
     controls are the voltages themselves (the actuator's ctrl), the drive runs inside
     MuJoCo. The scene is left in the final state of the last run (its beam dofs).
@@ -167,8 +167,9 @@ def run_native(scene, native, drives: Sequence, v_steps: Sequence[np.ndarray], i
     decided = None
     try:
         try:
-            final, bad, before = roller(m, state0, controls, len(template), spec, n, sample_steps, take, nthread,
-                                      ahead_of_stop(samples, dt), spare_datas(native, m))
+            final, bad, before = roller(m, state0, controls, len(template), spec, n, sample_steps, take,
+                                        nthread=nthread, max_chunk=ahead_of_stop(samples, dt),
+                                        spares=spare_datas(native, m))
         except Decided as stop:         # the run ends at the decision (Samples.stop)
             final, bad, before, n, decided = stop.state[None], None, stop.before[None], stop.step, stop
         if bad is not None:

@@ -83,7 +83,7 @@ def _first_bad(state0: np.ndarray, state: np.ndarray) -> tuple:
 
 
 def roll(model, state0: np.ndarray, controls, ncontrol: int, control_spec, n: int, sample_steps: np.ndarray,
-         take, nthread: int = 0, max_chunk: Optional[int] = None, spares: Optional[list] = None) -> tuple:
+         take, *, nthread: int = 0, max_chunk: Optional[int] = None, spares: Optional[list] = None) -> tuple:
     """The core of both engines: ``mujoco.rollout`` of ``len(state0)`` runs of ``model`` over
     ``n`` steps, in chunks that keep memory bounded. ``controls(s0, c, out)`` fills the
     (B, c, ncontrol) controls of steps s0 .. s0 + c; ``take(b, k, state, before)`` is called
@@ -106,7 +106,8 @@ def roll(model, state0: np.ndarray, controls, ncontrol: int, control_spec, n: in
                            max(-(-n // PIPELINE_CHUNKS), -(-PIPELINE_MIN_STEPS // B)), max_chunk or n)))
     datas = _borrow_datas(model, max(nthread, 1), spares)
     try:
-        return _roll(model, datas, state0, controls, ncontrol, control_spec, n, sample_steps, take, nthread, chunk, B)
+        return _roll(model, datas, state0, controls, ncontrol, control_spec, n, sample_steps, take=take,
+                     nthread=nthread, chunk=chunk, B=B)
     finally:
         if spares is not None:
             spares.extend(datas)
@@ -140,7 +141,7 @@ def _borrow_datas(model, k: int, spare: Optional[list]) -> list:
     return out + [mujoco.MjData(model) for _ in range(k - len(out))]
 
 
-def _roll(model, datas, state0, controls, ncontrol, control_spec, n, sample_steps, take, nthread, chunk, B):
+def _roll(model, datas, state0, controls, ncontrol, control_spec, n, sample_steps, *, take, nthread, chunk, B):
     starts = list(range(0, n, chunk))
     control = [np.zeros((B, chunk, ncontrol)) for _ in starts[:2]]    # one per chunk in flight
     i_next = 1                                      # next sample index (same for all runs)
@@ -228,8 +229,8 @@ def run(scene, drives: Sequence, v_steps: Sequence[np.ndarray], initial_curvatur
         samples[b].take(k * dt, v_steps[b][k - 1], drives[b].signals())
 
     try:
-        final, bad, before = roll(m, state0, controls, nv, CONTROL, n, sample_steps, take, nthread,
-                                  ahead_of_stop(samples, dt), spare_datas(scene, m))
+        final, bad, before = roll(m, state0, controls, nv, CONTROL, n, sample_steps, take, nthread=nthread,
+                                  max_chunk=ahead_of_stop(samples, dt), spares=spare_datas(scene, m))
         decided = None
     except Decided as stop:             # the run ends at the decision (Samples.stop)
         final, bad, before, n, decided = stop.state[None], None, stop.before[None], stop.step, stop

@@ -247,7 +247,7 @@ def _roller(native, meta: Optional[dict]):
     the same arguments and returns (``take`` at every sample with its state and the one
     before, the first bad state found at a sample), float32 states read back per sample."""
 
-    def roll(model, state0, controls, ncontrol, control_spec, n, sample_steps, take, nthread=0, max_chunk=None,
+    def roll(model, state0, controls, ncontrol, control_spec, n, sample_steps, take, *, nthread=0, max_chunk=None,
              spares=None):
         B = len(state0)
         w = _worlds(native, B)

@@ -60,7 +60,7 @@ class DmControlTrackingTask(CurvatureTrackingTask, base.Task):
         base.Task.__init__(self, random=self.random)
 
 
-def make_dm_control_environment(scene: Scene, drive, reference, payload_mass_range, initial_curvature_range,
+def make_dm_control_environment(scene: Scene, drive, reference, *, payload_mass_range, initial_curvature_range,
                                 reward_margin: float, seed, time_limit: float, n_sub: int) -> control.Environment:
     """``control.Environment`` of the task on ``scene`` with ``drive`` (the parameters checked
     by :func:`mjeap.envs.environment.make_environment`)."""

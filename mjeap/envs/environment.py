@@ -51,7 +51,7 @@ BACKENDS = ("auto", "dm_control", "dm_env")
 
 
 def make_environment(actuator: str = "pedot-micro", reference: Optional[Callable[[float], float]] = None,
-                     orientation: str = "up", payload: Optional[Payload] = Payload(12.6e-6, 6.27e-3),
+                     *, orientation: str = "up", payload: Optional[Payload] = Payload(12.6e-6, 6.27e-3),
                      payload_mass_range: Optional[Tuple[float, float]] = None,
                      initial_curvature_range: Tuple[float, float] = (0.0, 0.0), control_interval: float = 1e-2,
                      time_limit: float = 20.0, seed=None, drive: Optional[str] = None, drive_params=None,
@@ -78,8 +78,9 @@ def make_environment(actuator: str = "pedot-micro", reference: Optional[Callable
     n_sub = max(1, int(round(control_interval / scene.timestep)))
     if use_dm_control:
         from .dm_control_env import make_dm_control_environment
-        return make_dm_control_environment(scene, drv, reference, payload_mass_range, initial_curvature_range,
-                                           reward_margin, seed, time_limit, n_sub)
+        return make_dm_control_environment(scene, drv, reference, payload_mass_range=payload_mass_range,
+                                           initial_curvature_range=initial_curvature_range,
+                                           reward_margin=reward_margin, seed=seed, time_limit=time_limit, n_sub=n_sub)
     task = CurvatureTrackingTask(reference, payload_mass_range, initial_curvature_range, reward_margin, random=seed)
     return TrackingEnvironment(BeamPhysics.from_scene(scene, drv), task, time_limit=time_limit, n_sub_steps=n_sub)
 

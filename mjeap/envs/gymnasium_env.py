@@ -79,7 +79,7 @@ class CurvatureTrackingEnv(gymnasium.Env):
     metadata = {"render_modes": list(render_modes()), "render_fps": None}
 
     def __init__(self, actuator: str = "pedot-micro", reference: Optional[Callable[[float], float]] = None,
-                 orientation: str = "up", payload: Optional[Payload] = Payload(12.6e-6, 6.27e-3),
+                 *, orientation: str = "up", payload: Optional[Payload] = Payload(12.6e-6, 6.27e-3),
                  payload_mass_range: Optional[Tuple[float, float]] = None,
                  initial_curvature_range: Tuple[float, float] = (0.0, 0.0), control_interval: float = 1e-2,
                  time_limit: float = 20.0, drive: Optional[str] = None, drive_params: Optional[dict] = None,

@@ -56,7 +56,7 @@ class NativeModel:
             self.check_stability()
         self.data = mujoco.MjData(self.model)
         self.part = ActuatorPart(self.model, scene.handles, scene.layout, scene.actuator, scene.units,
-                                 scene.representation, scene.payload, rotation=scene.rotation)
+                                 scene.representation, payload=scene.payload, rotation=scene.rotation)
         self.part.bind(self.data)
         self.actuator_id = mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_ACTUATOR, self.handles.actuator)
 

@@ -29,7 +29,7 @@ class ActuatorPart:
     clamp frame where the clamp cannot move; None reads it from the clamp body."""
 
     def __init__(self, model: mujoco.MjModel, handles, layout, actuator, units, representation: str,
-                 payload=None, prefix: str = "", rotation: Optional[np.ndarray] = None):
+                 *, payload=None, prefix: str = "", rotation: Optional[np.ndarray] = None):
         self.model, self.handles, self.layout, self.actuator = model, handles, layout, actuator
         self.units, self.representation, self.payload, self.prefix = units, representation, payload, prefix
         m = model

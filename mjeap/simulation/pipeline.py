@@ -48,7 +48,7 @@ class Plan:
 
 def plan(engine: Engine, engine_reason: str, waves: Sequence, drives: Sequence,
          parts: Union[Sequence, Callable[[], Sequence]], duration: float,
-         dt: float, sample_interval: Optional[float], meta: dict, *, max_steps: Optional[int] = None,
+         dt: float, sample_interval: Optional[float], *, meta: dict, max_steps: Optional[int] = None,
          remedy: str = SCENE_TIMESTEP, rest: bool = False) -> Plan:
     """The plan of a run of ``duration`` s at steps of ``dt`` s on ``engine`` (chosen for
     ``engine_reason``): per drive (None: passive) its ``waves`` entry's voltage per step
@@ -198,7 +198,7 @@ def _states_read(job: Job):
         return None
     t0 = _time.perf_counter()
     p = plan(native, "every step read from mujoco.rollout's states", [wave], [drv], lambda: [native.part(scene, drv)],
-             job.duration, scene.timestep, scene.timestep, scene_meta(scene, drv, wave, job.duration, kappa0))
+             job.duration, scene.timestep, scene.timestep, meta=scene_meta(scene, drv, wave, job.duration, kappa0))
     try:
         tip = native.read_states(scene, drv, p.v_steps[0], kappa0, p.samples[0], tip_only=job.tip_only)
     except StatesUnread:
@@ -222,7 +222,7 @@ def _run_scene(job: Job):
     scene, (drv,), (wave,), (kappa0,) = job.target, job.drives, job.waves, job.initial_curvatures
     eng, engine_reason = choose(job.engine, scene, drv, job.controller)
     p = plan(eng, engine_reason, [wave], [drv], lambda: [eng.part(scene, drv)], job.duration, scene.timestep,
-             job.sample_interval, scene_meta(scene, drv, wave, job.duration, kappa0), max_steps=job.max_steps)
+             job.sample_interval, meta=scene_meta(scene, drv, wave, job.duration, kappa0), max_steps=job.max_steps)
     (samples,) = p.samples
     if job.stop_when_periodic is not None:     # on the sampling the run has (its default without one)
         from ..engines.frame import DEFAULT_SAMPLES
@@ -247,7 +247,7 @@ def _run_batch(job: Job):
     eng, engine_reason = choose(job.engine, scene, drives[0], None, batched=True)
     engine_meta: dict = {}              # what the engine says of its run (the warp engine's settings)
     p = plan(eng, engine_reason, waves, drives, lambda: [eng.part(scene, drives[0])] * len(waves), job.duration,
-             scene.timestep, job.sample_interval, {"batch": len(waves), "nthread": job.nthread})
+             scene.timestep, job.sample_interval, meta={"batch": len(waves), "nthread": job.nthread})
     return execute(p.meta, lambda: run_checked(eng, scene, drives, p.v_steps, kappa0, p.sample_steps, p.samples,
                                                nthread=job.nthread, meta=engine_meta),
                    lambda error: None if error is not None else
@@ -264,7 +264,8 @@ def _run_system(job: Job):
     system = job.target
     eng, engine_reason = choose_system(job.engine, system, job.controller, job.on_sample)
     p = plan(eng, engine_reason, job.waves, job.drives, system.parts, job.duration, system.timestep,
-             job.sample_interval, system.describe_run(job.waves, job.controller, job.controller_name, job.duration),
+             job.sample_interval,
+             meta=system.describe_run(job.waves, job.controller, job.controller_name, job.duration),
              remedy=job.remedy, rest=True)
     frame = SystemRun(system, p, job.initial_curvatures, on_sample=job.on_sample, controller=job.controller,
                       ctrl_name=job.controller_name)

@@ -213,7 +213,7 @@ class Scene:
     :mod:`mjeap.simulation.accuracy`; the scene as built keeps the arguments given).
     """
 
-    def __init__(self, actuator: Union[str, Actuator], representation: str = "hinge",
+    def __init__(self, actuator: Union[str, Actuator], *, representation: str = "hinge",
                  segments: int = DEFAULT_SEGMENTS, orientation: str = "horizontal",
                  payload: Union[Payload, str, None] = None, units: Optional[UnitSystem] = None,
                  timestep: Optional[float] = None, integrator: Optional[str] = None,
@@ -264,7 +264,7 @@ class Scene:
         self.choice = self._choose_timestep_and_damping(zeta, timestep)
         self.model = apply_dof_damping(self.spec.compile())
         self.part = ActuatorPart(self.model, self.handles, self.layout, self.actuator, self.units,
-                                 representation, payload, rotation=self.rotation)
+                                 representation, payload=payload, rotation=self.rotation)
         self.data = mujoco.MjData(self.model)
         self.reset()
 

@@ -450,7 +450,7 @@ class System:
             tw = a.twin
             clamp = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, a.prefix + tw.handles.clamp_body)
             fixed = m.body_weldid[clamp] == 0          # welded to the world: a constant clamp frame
-            part = ActuatorPart(m, tw.handles, tw.layout, tw.actuator, units, tw.representation, tw.payload,
+            part = ActuatorPart(m, tw.handles, tw.layout, tw.actuator, units, tw.representation, payload=tw.payload,
                                 prefix=a.prefix, rotation=None)
             part.bind(self.data)
             if fixed:
