@@ -1,22 +1,14 @@
 """Runs at a stated accuracy on the answer: a target on named metrics of the tip curvature
 (a sweep's, a map's, an optimisation's), not on the whole trajectory
-(:mod:`mjeap.simulation.accuracy`).
-
-Each metric's error is taken relative to its own scale (:data:`METRIC_SCALES`):
-
-* ``peak_to_peak`` (last drive period): the swing of the run (peak-to-peak tip curvature
-  over the whole run), as the trajectory's target is;
-* ``max_stress_proxy``, ``max_tip_deflection``: their own value;
-* ``settling_time``: the drive period (the run's duration without one);
-* ``returns`` (a boolean: the tip curvature changes sign in the last period): its margin,
-  min(max kappa, -min kappa) over the last period relative to the swing (> 0: returns). It is
-  *decided* only where |margin| exceeds the margin's estimated error; else the run is
-  refined, and a point still undecided after MAX_REFINEMENTS, or whose next model would cost
-  more than the scene's own (a margin of 3e-4 of the swing asked for 137 segments at 0.16 ms,
-  2 minutes), is run on the scene's own (default) model, which then decides it
-  (``decided_by`` says so): no point is left undecided.
-  A boolean's target is its decision: the margin's estimated error is reported (the row's
-  ``estimated_error.returns``) but not held to the target (a decided answer is the answer).
+(:mod:`mjeap.simulation.accuracy`). Each metric's error is taken relative to its own scale
+(:mod:`mjeap.simulation.metric_scales`). ``returns`` (a boolean) is *decided* only where
+|margin| exceeds the margin's estimated error; else the run is refined, and a point still
+undecided after MAX_REFINEMENTS, or whose next model would cost more than the scene's own (a
+margin of 3e-4 of the swing asked for 137 segments at 0.16 ms, 2 minutes), is run on the
+scene's own (default) model, which then decides it (``decided_by`` says so): no point is
+left undecided. A boolean's target is its decision: the margin's estimated error is reported
+(the row's ``estimated_error.returns``) but not held to the target (a decided answer is the
+answer).
 
 Time-scale separation. A question read on the last drive period (:data:`LAST_PERIOD_METRICS`)
 whose drive is slow against the beam's modes (the drive's fastest time constant, 1 / its
@@ -58,7 +50,8 @@ sample)| / 3, combined in quadrature. Each run is sampled every step otherwise: 
 held over a step puts a square wave's peak one step after its switch, and a grid coarser
 than the step reads the models' peaks unequally (on thick-trilayer's length sweep that hid
 a 0.7 % error from the companions); such a run is read from the states ``mujoco.rollout``
-returns for all its steps (the native engine's :meth:`~mjeap.engines.native.NativeEngine.read_states`), not sampled from Python, and a
+returns for all its steps (the native engine's
+:meth:`~mjeap.engines.native.NativeEngine.read_states`), not sampled from Python, and a
 refinement reuses the runs already made (its 2 h companion is the last chosen run where it
 halves the step). Where a metric's estimate exceeds the target (or a boolean is undecided), the
 error model e = sqrt((a / N^2)^2 + (b h)^2) takes a and b from the measured parts and a finer
@@ -76,25 +69,15 @@ import numpy as np
 from ..engines.result import TipPath
 from ..errors import ParameterError
 from ..model.modes import modal_frequencies
+from .metric_scales import LAST_PERIOD_METRICS, METRIC_SCALES, check_metrics, metric_quantity, metric_scale, relative
 from .accuracy import (SAFETY, ErrorModel, Model, as_error_model, check_accuracy, check_targetable, choose_model,
                        fewer_segments)
 
-__all__ = ["METRIC_SCALES", "check_metrics", "answerable", "relaxed_step_cap", "last_period",
-           "peak_to_peak", "returns_margin", "metric_quantity", "metric_scale", "run_metrics_at_accuracy",
-           "reported_value"]
+__all__ = ["relaxed_step_cap", "run_metrics_at_accuracy"]
 
-#: the metrics a target may be put on, and the scale each one's error is relative to
-METRIC_SCALES = {"peak_to_peak": "swing", "returns": "margin", "max_stress_proxy": "value",
-                 "max_tip_deflection": "value", "settling_time": "period"}
-#: metrics read on the last drive period: slow questions where the drive is (time-scale
-#: separation); the others (a maximum over the run, a settling time) read the release
-#: transient and keep the trajectory's step bound
-LAST_PERIOD_METRICS = ("peak_to_peak", "returns")
 #: a relaxed step divides the drive period / SAMPLES_PER_PERIOD (the square wave's switching
 #: instants on its grid)
 SAMPLES_PER_PERIOD = 100
-#: bookkeeping columns of a sweep: not quantities, ignored where a target's metrics are read
-BOOKKEEPING = ("estimated_error", "stopped_early")
 #: the drive's fastest time constant must be this many x the first mode's 1 / omega_1
 SEPARATION = 10.0
 #: a mode as slow as the drive (omega tau < SEPARATION) is resolved by a relaxed step:
@@ -127,28 +110,6 @@ COST_PER_STEP = (1.0, 1.6)
 #: a model is never chosen with more steps than this (a boolean at its edge falls back to
 #: the scene's own model instead)
 MAX_MODEL_STEPS = 2_000_000
-
-
-def check_metrics(metrics) -> tuple:
-    """``metrics`` as a tuple of names of :data:`METRIC_SCALES`, refused otherwise."""
-    if isinstance(metrics, str):
-        metrics = (metrics,)
-    try:
-        names = tuple(str(m) for m in metrics)
-    except TypeError:
-        names = ()
-    bad = [m for m in names if m not in METRIC_SCALES] if names else [metrics]
-    if bad:
-        raise ParameterError("metrics", bad[0], f"names among {', '.join(METRIC_SCALES)} (a target on the "
-                             "trajectory: leave metrics out)")
-    return names
-
-
-def answerable(metrics: Sequence[str]) -> bool:
-    """Whether a target on ``metrics`` (a sweep's, bookkeeping columns aside) is one this
-    module answers: all of them tip-curvature metrics of :data:`METRIC_SCALES`."""
-    names = [m for m in metrics if m not in BOOKKEEPING]
-    return bool(names) and all(m in METRIC_SCALES for m in names)
 
 
 def _drive_tau(drive) -> Optional[float]:
@@ -202,61 +163,6 @@ def relaxed_step_cap(scene, drive, wave, metrics: Sequence[str] = LAST_PERIOD_ME
         why += (f"; {slow.size} mode(s) as slow as the drive (up to {w / (2 * math.pi):.3g} Hz) followed, not damped: "
                 f"omega h <= {RESOLVED_MODE:g}")
     return cap, why
-
-
-# ---------------------------------------------------------------- the quantities
-def last_period(time: np.ndarray, period: Optional[float]) -> np.ndarray:
-    """Mask of the samples in the last drive period (``period`` s; the second half of the
-    run without one, or where the run is not longer than it)."""
-    t_end = time[-1]
-    t0 = t_end - period if period and period < t_end else 0.5 * t_end
-    return time >= t0 - 1e-9 * t_end           # the sample at the period's start (round-off) included
-
-
-def peak_to_peak(time, kappa, period) -> float:
-    """Peak-to-peak tip curvature (1/m) over the last drive period."""
-    return float(np.ptp(kappa[last_period(time, period)]))
-
-
-def returns_margin(time, kappa, period) -> float:
-    """min(max kappa, -min kappa) over the last drive period (1/m): > 0 where the tip
-    curvature changes sign there (seed 000's criterion), its distance from deciding else."""
-    k = kappa[last_period(time, period)]
-    return float(min(k.max(), -k.min()))
-
-
-def _settling_time(r) -> float:
-    k = r.tip_curvature
-    band = 0.02 * max(abs(k[-1] - k[0]), 1e-300)
-    outside = np.nonzero(np.abs(k - k[-1]) > band)[0]
-    return float(r.time[outside[-1] + 1]) if outside.size and outside[-1] + 1 < k.size else 0.0
-
-
-def metric_quantity(name: str, r, period: Optional[float]) -> float:
-    """The number behind metric ``name`` in run ``r`` (its margin for ``returns``)."""
-    if name == "peak_to_peak":
-        return peak_to_peak(r.time, r.tip_curvature, period)
-    if name == "returns":
-        return returns_margin(r.time, r.tip_curvature, period)
-    if name == "max_stress_proxy":
-        return float(np.abs(r.tip_curvature).max())
-    if name == "max_tip_deflection":
-        return float(np.abs(r.tip_position[:, 1]).max())
-    return _settling_time(r)
-
-
-def metric_scale(name: str, r, value: float, period: Optional[float], duration: float) -> float:
-    """The scale of metric ``name``'s error in run ``r`` (:data:`METRIC_SCALES`)."""
-    kind = METRIC_SCALES[name]
-    if kind in ("swing", "margin"):
-        return float(np.ptp(r.tip_curvature))
-    if kind == "period":
-        return period or duration
-    return abs(value)
-
-
-def _relative(x: float, scale: float) -> float:
-    return x / scale if scale > 0 else (0.0 if x == 0 else math.inf)
 
 
 # ---------------------------------------------------------------- the choice
@@ -332,14 +238,14 @@ def _evaluate(metrics, runs, period, duration, step) -> Dict[str, dict]:
     for name in metrics:
         q = [metric_quantity(name, r, period) for r in (f, mid, fewer, sparse)]
         scale = metric_scale(name, f, q[0], period, duration)
-        e_h = _relative(abs(q[0] - q[1]), scale) / STEP_RICHARDSON
-        e_s = _relative(abs(q[1] - q[2]), scale) / ((n_f / n_s) ** 2 - 1)
-        e_t = _relative(abs(q[0] - q[3]), scale) / SAMPLING_RICHARDSON if coarse else 0.0
+        e_h = relative(abs(q[0] - q[1]), scale) / STEP_RICHARDSON
+        e_s = relative(abs(q[1] - q[2]), scale) / ((n_f / n_s) ** 2 - 1)
+        e_t = relative(abs(q[0] - q[3]), scale) / SAMPLING_RICHARDSON if coarse else 0.0
         q4 = None if quad is None or coarse else metric_quantity(name, quad, period)
         x = None if q4 is None else _extrapolate(q[0], q[1], q4)
         value = q[0]
         if x is not None:
-            value, e_h = x[0], _relative(x[1], scale)
+            value, e_h = x[0], relative(x[1], scale)
         e = math.sqrt(e_h ** 2 + e_s ** 2 + e_t ** 2)
         row = {"value": value, "estimated_error": e, "step_error": e_h, "segments_error": e_s,
                "sampling_error": e_t, "scale": METRIC_SCALES[name], "extrapolated": x is not None}
@@ -348,18 +254,10 @@ def _evaluate(metrics, runs, period, duration, step) -> Dict[str, dict]:
         if x is not None:
             row["run_value"] = q[0]
         if name == "returns":       # decided beyond its error, and on the run's own side where extrapolated
-            margin = _relative(value, scale)
+            margin = relative(value, scale)
             row.update(margin=margin, decided=abs(margin) > e and (x is None or (value > 0) == (q[0] > 0)))
         out[name] = row
     return out
-
-
-def reported_value(result, name: str, period: Optional[float]) -> float:
-    """The value of metric ``name`` a run at a target on metrics reports (its margin for
-    ``returns``): ``meta['accuracy']['metrics'][name]['value']`` where the target was on
-    it (extrapolated where the report says so), else read from the run's samples."""
-    found = result.meta.get("accuracy", {}).get("metrics", {}).get(name)
-    return float(found["value"]) if found and "value" in found else metric_quantity(name, result, period)
 
 
 def _needs(metrics: Dict[str, dict], target: float) -> float:
@@ -372,6 +270,121 @@ def _needs(metrics: Dict[str, dict], target: float) -> float:
         if "decided" in m and not m["decided"]:
             need = min(need, abs(m["margin"]) / 2)
     return 0.0 if need == math.inf else need
+
+
+class _Choice:
+    """One question's runs of ``scene`` (``run(scene, interval, every_step, tip_only)``): the
+    steps it may take, every run made (kept, so an attempt reuses what an earlier one ran)
+    and its log; :meth:`attempt` runs a model with its companions and evaluates the metrics."""
+
+    def __init__(self, scene, run, names, duration: float, drive, wave, sample_interval: Optional[float]):
+        self.scene, self.run, self.names, self.duration = scene, run, names, duration
+        self.sample_interval = sample_interval
+        self.period = 1.0 / wave.frequency if wave is not None and getattr(wave, "frequency", 0) else None
+        self.relaxed, self.why = relaxed_step_cap(scene, drive, wave, names)
+        # not relaxed: 1/8 of the first mode's period, and beta / 2 (the step's own damping under
+        # 'discrete' at most half the beam's: a maximum over the release transient reads its
+        # ringing, which a larger step damps in the run and its companions alike, unseen)
+        trajectory_cap = min(1.0 / (8 * scene.choice.first_frequency), 0.5 * scene.choice.rayleigh_beta or math.inf)
+        h_cap = self.relaxed if self.relaxed is not None else trajectory_cap
+        # each run sampled every step (a peak one step after a switch, the drive held over the
+        # step, is then each model's own); the relaxed step on a grid of the drive period
+        self.own_grid = self.relaxed is not None and sample_interval is None
+        self.grid = self.period / SAMPLES_PER_PERIOD if self.own_grid else (sample_interval or duration)
+        self.h_cap = min(h_cap, self.grid)
+        self.widest = 4 if self.relaxed is not None and self.own_grid else 2   # the widest companion's step factor
+        self.log: List[dict] = []
+        self.done: Dict[tuple, tuple] = {}      # (model, interval) -> (scene, result)
+
+    def one(self, model: Model, role: str, interval=None, tip_only: bool = False):
+        """The run of ``model`` sampled every ``interval`` s (a companion's: ``tip_only``,
+        where it is read from its states: the tip alone, all its metrics read)."""
+        key = (model, interval)
+        if key in self.done and (tip_only or not isinstance(self.done[key][1], TipPath)):
+            self.log.append({"role": role + " (reused)", **asdict(model), "wall_time_s": 0.0})
+            return self.done[key]
+        s = self.scene.variant(model.segments, model.timestep, model.integrator)
+        t = _time.perf_counter()
+        out = self.run(s, interval, every_step=interval == model.timestep, tip_only=tip_only)
+        self.log.append({"role": role, **asdict(model), "wall_time_s": _time.perf_counter() - t})
+        self.done[key] = s, out
+        return s, out
+
+    def extrapolating(self, model: Model) -> bool:
+        """Whether an attempt at ``model`` adds the run at 4 h (:func:`_extrapolate`): relaxed
+        steps under 'discrete', each run sampled every step, 4 h dividing the drive's grid."""
+        k = self.grid / (4 * model.timestep)
+        return self.relaxed is not None and self.own_grid and model.integrator == "discrete" and k >= 1 - 1e-9 and \
+            abs(k - round(k)) <= 1e-9 * k
+
+    def runs_of(self, model: Model) -> list:
+        """The runs an attempt at ``model`` needs: it and its companions (2 h, fewer segments
+        at 2 h, and 4 h where it extrapolates)."""
+        h2, si = 2 * model.timestep, self.sample_interval
+        out = [(model, si or model.timestep), (Model(model.segments, h2, model.integrator), si or h2),
+               (Model(fewer_segments(model.segments), h2, model.integrator), si or h2)]
+        if self.extrapolating(model):
+            out.append((Model(model.segments, 2 * h2, model.integrator), 2 * h2))
+        return out
+
+    def new_cost(self, model: Model) -> float:
+        """The cost of an attempt at ``model``, less the runs already done."""
+        return sum(_cost(m, self.duration) for m, i in self.runs_of(model) if (m, i) not in self.done)
+
+    def choose(self, em: ErrorModel, need: float, h_cap: float) -> Model:
+        return _choose(self.scene, em, need, self.duration, self.grid, h_cap, self.widest)
+
+    def refine(self, em: ErrorModel, need: float, last: Model, pre_asymptotic: bool) -> Model:
+        """The cheapest next model by the error model: :func:`_choose`'s, or ``last``'s
+        segments at an integer fraction of its step (its runs then serve as companions);
+        where ``last``'s step was outside the asymptotic range (``pre_asymptotic``: a
+        metric's observed order outside EXTRAPOLATION_ORDERS), half its step: at its
+        segments where the error model's spatial part allows them (the runs at h and 2 h
+        then serve as companions), else at the segments that part needs."""
+        if pre_asymptotic:
+            h = min(self.h_cap, last.timestep / 2)
+            if em.spatial / last.segments ** 2 <= need / SAFETY:
+                return Model(last.segments, h, _integrator(self.scene, h))
+            return self.choose(ErrorModel(em.spatial, 0.0), need, h)
+        best = self.choose(em, need, self.h_cap)
+        for k in (2, 3, 4, 6, 8):
+            m = Model(last.segments, last.timestep / k, last.integrator)
+            if em.predict(m) <= need / SAFETY and _integrator(self.scene, m.timestep) == last.integrator and \
+                    self.new_cost(m) < self.new_cost(best):
+                best = m
+        return best
+
+    def attempt(self, model: Model, role: str):
+        """(scene, result, metrics) of a run of ``model`` checked against its companions."""
+        (m_f, i_f), (m_mid, i_mid), (m_s, i_s), *rest = self.runs_of(model)
+        chosen, f = self.one(m_f, role, i_f)
+        _, mid = self.one(m_mid, "companion", i_mid, tip_only=True)
+        _, fewer = self.one(m_s, "spatial companion", i_s, tip_only=True)
+        quad = self.one(rest[0][0], "extrapolation companion", rest[0][1], tip_only=True)[1] if rest else None
+        return chosen, f, _evaluate(self.names, ((f, mid, fewer, quad), (model.segments, m_s.segments)), self.period,
+                                    self.duration, model.timestep)
+
+    def decide_by_default(self, found: Dict[str, dict]):
+        """The scene's own (default) model run, deciding the booleans still undecided in
+        ``found`` (updated); its result."""
+        scene, t = self.scene, _time.perf_counter()
+        result = self.run(scene, self.sample_interval)
+        self.log.append({"role": "default model (undecided at the target)", "segments": scene.layout.segments,
+                         "timestep": scene.timestep, "integrator": scene.integrator,
+                         "wall_time_s": _time.perf_counter() - t})
+        for k, m in found.items():
+            if "decided" in m and not m["decided"]:
+                value = metric_quantity(k, result, self.period)
+                for gone in ("run_value", "observed_step_order"):
+                    m.pop(gone, None)
+                scale = metric_scale(k, result, value, self.period, self.duration)
+                m.update(value=value, margin=relative(value, scale), extrapolated=False, decided=True,
+                         decided_by=DEFAULT_DECIDES)
+        return result
+
+
+#: who decides a boolean the chosen model leaves undecided
+DEFAULT_DECIDES = "the scene's own model: undecided by the chosen model's estimate"
 
 
 def run_metrics_at_accuracy(scene, run, *, metrics: Sequence[str], accuracy: float, duration: float, drive,
@@ -393,94 +406,15 @@ def run_metrics_at_accuracy(scene, run, *, metrics: Sequence[str], accuracy: flo
     given = None if error_model is None else as_error_model(error_model)
     check_targetable(scene, accuracy)
     t0 = _time.perf_counter()
-    period = 1.0 / wave.frequency if wave is not None and getattr(wave, "frequency", 0) else None
-    relaxed, why = relaxed_step_cap(scene, drive, wave, names)
-    # not relaxed: 1/8 of the first mode's period, and beta / 2 (the step's own damping under
-    # 'discrete' at most half the beam's: a maximum over the release transient reads its
-    # ringing, which a larger step damps in the run and its companions alike, unseen)
-    trajectory_cap = min(1.0 / (8 * scene.choice.first_frequency), 0.5 * scene.choice.rayleigh_beta or math.inf)
-    h_cap = relaxed if relaxed is not None else trajectory_cap
-    # each run sampled every step (a peak one step after a switch, the drive held over the
-    # step, is then each model's own); the relaxed step on a grid of the drive period
-    own_grid = relaxed is not None and sample_interval is None
-    grid = period / SAMPLES_PER_PERIOD if own_grid else (sample_interval or duration)
-    h_cap = min(h_cap, grid)
-    widest = 4 if relaxed is not None and own_grid else 2      # the widest companion's step factor
-    log: List[dict] = []
-    done: Dict[tuple, tuple] = {}        # (model, interval) -> (scene, result): a refinement's companions reuse them
-
-    def one(model: Model, role: str, interval=None, tip_only: bool = False):
-        """The run of ``model`` sampled every ``interval`` s (a companion's: ``tip_only``,
-        where it is read from its states: the tip alone, all its metrics read)."""
-        if (model, interval) in done and (tip_only or not isinstance(done[model, interval][1], TipPath)):
-            log.append({"role": role + " (reused)", **asdict(model), "wall_time_s": 0.0})
-            return done[model, interval]
-        s = scene.variant(model.segments, model.timestep, model.integrator)
-        t = _time.perf_counter()
-        out = run(s, interval, every_step=interval == model.timestep, tip_only=tip_only)
-        log.append({"role": role, **asdict(model), "wall_time_s": _time.perf_counter() - t})
-        done[model, interval] = s, out
-        return s, out
-
-    def extrapolating(model: Model) -> bool:
-        """Whether an attempt at ``model`` adds the run at 4 h (:func:`_extrapolate`): relaxed
-        steps under 'discrete', each run sampled every step, 4 h dividing the drive's grid."""
-        k = grid / (4 * model.timestep)
-        return relaxed is not None and own_grid and model.integrator == "discrete" and k >= 1 - 1e-9 and \
-            abs(k - round(k)) <= 1e-9 * k
-
-    def runs_of(model: Model) -> list:
-        """The runs an attempt at ``model`` needs: it and its companions (2 h, fewer segments
-        at 2 h, and 4 h where it extrapolates)."""
-        h2 = 2 * model.timestep
-        out = [(model, sample_interval or model.timestep),
-               (Model(model.segments, h2, model.integrator), sample_interval or h2),
-               (Model(fewer_segments(model.segments), h2, model.integrator), sample_interval or h2)]
-        if extrapolating(model):
-            out.append((Model(model.segments, 2 * h2, model.integrator), 2 * h2))
-        return out
-
-    def new_cost(model: Model) -> float:
-        """The cost of an attempt at ``model``, less the runs already done."""
-        return sum(_cost(m, duration) for m, i in runs_of(model) if (m, i) not in done)
-
-    def refine(em: ErrorModel, need: float, last: Model, pre_asymptotic: bool) -> Model:
-        """The cheapest next model by the error model: :func:`_choose`'s, or ``last``'s
-        segments at an integer fraction of its step (its runs then serve as companions);
-        where ``last``'s step was outside the asymptotic range (``pre_asymptotic``: a
-        metric's observed order outside EXTRAPOLATION_ORDERS), half its step: at its
-        segments where the error model's spatial part allows them (the runs at h and 2 h
-        then serve as companions), else at the segments that part needs."""
-        if pre_asymptotic:
-            h = min(h_cap, last.timestep / 2)
-            if em.spatial / last.segments ** 2 <= need / SAFETY:
-                return Model(last.segments, h, _integrator(scene, h))
-            return _choose(scene, ErrorModel(em.spatial, 0.0), need, duration, grid, h, widest)
-        best = _choose(scene, em, need, duration, grid, h_cap, widest)
-        for k in (2, 3, 4, 6, 8):
-            m = Model(last.segments, last.timestep / k, last.integrator)
-            if em.predict(m) <= need / SAFETY and _integrator(scene, m.timestep) == last.integrator and \
-                    new_cost(m) < new_cost(best):
-                best = m
-        return best
-
-    def attempt(model: Model, role: str):
-        (m_f, i_f), (m_mid, i_mid), (m_s, i_s), *rest = runs_of(model)
-        chosen, f = one(m_f, role, i_f)
-        _, mid = one(m_mid, "companion", i_mid, tip_only=True)
-        _, fewer = one(m_s, "spatial companion", i_s, tip_only=True)
-        quad = one(rest[0][0], "extrapolation companion", rest[0][1], tip_only=True)[1] if rest else None
-        return chosen, f, _evaluate(names, ((f, mid, fewer, quad), (model.segments, m_s.segments)), period,
-                                    duration, model.timestep)
-
+    c = _Choice(scene, run, names, duration, drive, wave, sample_interval)
     if given is not None:       # not below START_SEGMENTS: a family's first point (its lightest load, on the
         # map) predicts too few for the rest (from 4 segments 13 of the map's 23 other points were refined)
-        model = _choose(scene, given, target, duration, grid, h_cap, widest)
+        model = c.choose(given, target, c.h_cap)
         model = Model(max(model.segments, START_SEGMENTS), model.timestep, model.integrator)
     else:
-        h0 = _on_grid(h_cap, grid / widest)
+        h0 = _on_grid(c.h_cap, c.grid / c.widest)
         model = Model(START_SEGMENTS, h0, _integrator(scene, h0))
-    chosen, result, found = attempt(model, "chosen")
+    chosen, result, found = c.attempt(model, "chosen")
     em = given or ErrorModel(0.0, 0.0)
     own_cost = _cost(Model(scene.layout.segments, scene.timestep, scene.integrator), duration)
     refinements, decided_by = 0, None
@@ -490,31 +424,37 @@ def run_metrics_at_accuracy(scene, run, *, metrics: Sequence[str], accuracy: flo
         short = [m for m in found.values() if (not m["decided"] if "decided" in m else m["estimated_error"] > target)]
         em = ErrorModel(max(max(m["segments_error"] for m in short) * model.segments ** 2, 1e-12),
                         max(max(m["step_error"] for m in short) / model.timestep, 1e-12))
-        nxt = refine(em, need, model, any("observed_step_order" in m and not m["extrapolated"] for m in short))
+        nxt = c.refine(em, need, model, any("observed_step_order" in m and not m["extrapolated"] for m in short))
         if duration / nxt.timestep > MAX_MODEL_STEPS or \
                 (nxt.segments <= model.segments and nxt.timestep >= model.timestep):
             break
-        if all("decided" in m for m in short) and new_cost(nxt) > own_cost:
+        if all("decided" in m for m in short) and c.new_cost(nxt) > own_cost:
             break       # only a boolean at its edge: the scene's own model decides it for less
         refinements += 1
         model = nxt
-        chosen, result, found = attempt(model, "refined")
+        chosen, result, found = c.attempt(model, "refined")
         need = _needs(found, target)
-    undecided = [k for k, m in found.items() if "decided" in m and not m["decided"]]
-    if undecided:           # a boolean at its edge: the scene's own model decides it
-        t = _time.perf_counter()
-        result = run(scene, sample_interval)
-        log.append({"role": "default model (undecided at the target)", "segments": scene.layout.segments,
-                    "timestep": scene.timestep, "integrator": scene.integrator,
-                    "wall_time_s": _time.perf_counter() - t})
-        chosen, decided_by = scene, "the scene's own model: undecided by the chosen model's estimate"
-        for k in undecided:
-            value = metric_quantity(k, result, period)
-            for gone in ("run_value", "observed_step_order"):
-                found[k].pop(gone, None)
-            found[k].update(value=value, margin=_relative(value, metric_scale(k, result, value, period, duration)),
-                            extrapolated=False, decided=True, decided_by=decided_by)
-    # the error reported and held to the target: the numbers' (a boolean's target is its decision)
+    if any("decided" in m and not m["decided"] for m in found.values()):    # a boolean at its edge
+        result = c.decide_by_default(found)
+        chosen, decided_by = scene, DEFAULT_DECIDES
+    report = _report(c, found, model, em, given=given, target=target, refinements=refinements, decided_by=decided_by,
+                     wall=_time.perf_counter() - t0)
+    result.meta["accuracy"] = report
+    if report["damped_modes"]:
+        result.meta.setdefault("warnings", []).append(report["damped_modes"])
+    if not report["met"]:
+        result.meta.setdefault("warnings", []).append(
+            f"accuracy target {target:g} on {', '.join(names)} not met: estimated error "
+            f"{report['estimated_error']:.3g} with {Model(**report['model']).describe()} after {refinements} "
+            "refinements")
+    return result, chosen, report
+
+
+def _report(c: _Choice, found: Dict[str, dict], model: Model, em: ErrorModel, *, given, target: float,
+            refinements: int, decided_by: Optional[str], wall: float) -> dict:
+    """What a choice reports (``meta['accuracy']``): the model, each metric, the error held
+    to the target (the numbers': a boolean's target is its decision), the runs."""
+    scene = c.scene
     numbers = [m["estimated_error"] for m in found.values() if "decided" not in m]
     worst = max(numbers or [m["estimated_error"] for m in found.values()])
     met = all(m["decided"] if "decided" in m else m["estimated_error"] <= target for m in found.values())
@@ -524,10 +464,10 @@ def run_metrics_at_accuracy(scene, run, *, metrics: Sequence[str], accuracy: flo
         damped = (f"modes above {1 / (math.pi * h):.3g} Hz overdamped by the step (backward Euler, h = {h:.3g} s; "
                   f"first mode {scene.choice.first_frequency:.3g} Hz, its damping ratio raised to about "
                   f"{math.pi * scene.choice.first_frequency * h:.2g}): the answer is the slow path")
-    report = {"quantity": "metrics: " + ", ".join(f"{k} (relative to its {METRIC_SCALES[k]})" for k in names),
+    report = {"quantity": "metrics: " + ", ".join(f"{k} (relative to its {METRIC_SCALES[k]})" for k in c.names),
               "target": target, "model": asdict(model), "estimated_error": worst, "met": met,
-              "metrics": found, "relaxed_step": why if relaxed is not None else None,
-              "relaxed_step_refused": None if relaxed is not None else why, "damped_modes": damped,
+              "metrics": found, "relaxed_step": c.why if c.relaxed is not None else None,
+              "relaxed_step_refused": None if c.relaxed is not None else c.why, "damped_modes": damped,
               "decided_by": decided_by,
               "estimate": "each metric on the chosen run against companions of the same segments at 2 h (step, "
                           "order 1 assumed) and of fewer segments at 2 h (segments, order 2), in quadrature; with "
@@ -537,16 +477,9 @@ def run_metrics_at_accuracy(scene, run, *, metrics: Sequence[str], accuracy: flo
               "error_model": {"spatial_a": em.spatial, "temporal_b_per_s": em.temporal,
                               "form": "e = sqrt((a / N^2)^2 + (b h)^2)",
                               "pilots": "given" if given is not None else "none: measured on the runs"},
-              "refinements": refinements, "runs": log, "wall_time_s": _time.perf_counter() - t0}
+              "refinements": refinements, "runs": c.log, "wall_time_s": wall}
     if refinements == 0 and given is None:      # the error model of this question, for the next
         report["error_model"].update(
             spatial_a=max(max(m["segments_error"] for m in found.values()) * model.segments ** 2, 1e-12),
             temporal_b_per_s=max(max(m["step_error"] for m in found.values()) / model.timestep, 1e-12))
-    result.meta["accuracy"] = report
-    if damped:
-        result.meta.setdefault("warnings", []).append(damped)
-    if not met:
-        result.meta.setdefault("warnings", []).append(
-            f"accuracy target {target:g} on {', '.join(names)} not met: estimated error {worst:.3g} with "
-            f"{Model(**report['model']).describe()} after {refinements} refinements")
-    return result, chosen, report
+    return report

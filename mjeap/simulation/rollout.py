@@ -94,7 +94,7 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
         make_drive(drive, scene, **(drive_params or {}))
     target = target_for(scene, accuracy)
     if metrics is not None:
-        from .metric_accuracy import check_metrics
+        from .metric_scales import check_metrics
         metrics = check_metrics(metrics)
     if error_model is not None and target is None:      # its values are checked by the choice, before any run
         raise ParameterError("error_model", error_model, "None without an accuracy target (it chooses the model for "
@@ -160,7 +160,7 @@ def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable
     kappa0 = [check_initial_curvature(k, scene.layout.length, "initial_curvatures") for k in kappa0]
     target = target_for(scene, accuracy)
     if metrics is not None:
-        from .metric_accuracy import check_metrics
+        from .metric_scales import check_metrics
         metrics = check_metrics(metrics)
     if target is not None:
         scene.part.check_derivable()

@@ -32,7 +32,7 @@ import numpy as np
 
 from ..drives import make_drive
 from .accuracy_claim import Case as TrajectoryCase
-from ..simulation.metric_accuracy import metric_quantity, metric_scale, reported_value
+from ..simulation.metric_scales import metric_quantity, metric_scale, reported_value
 from ..simulation.rollout import rollout
 from ..simulation.scene import Scene
 

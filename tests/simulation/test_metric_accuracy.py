@@ -11,7 +11,8 @@ from mjeap import Scene, rollout
 from mjeap.drives import make_drive
 from mjeap.errors import ParameterError
 from mjeap.simulation import pipeline
-from mjeap.simulation.metric_accuracy import check_metrics, relaxed_step_cap
+from mjeap.simulation.metric_accuracy import relaxed_step_cap
+from mjeap.simulation.metric_scales import check_metrics
 from mjeap.engines.frame import to_waveform
 
 GOLDEN = Path(__file__).resolve().parents[1] / "golden" / "metric_accuracy.json"

@@ -12,7 +12,7 @@ from typing import Callable, Dict, Optional, Sequence
 import numpy as np
 
 from ...errors import DivergenceError, ParameterError, check_registration
-from ...simulation.metric_accuracy import reported_value
+from ...simulation.metric_scales import reported_value
 from .points import PARAMETERS
 
 
@@ -24,7 +24,7 @@ def _period(point) -> Optional[float]:
 def metric_peak_to_peak(r, point, scene) -> float:
     """Peak-to-peak tip curvature (1/m) over the last drive period (the second half of the
     run without a frequency); at a target on it, the value the accuracy report gives
-    (:func:`mjeap.simulation.metric_accuracy.reported_value`)."""
+    (:func:`mjeap.simulation.metric_scales.reported_value`)."""
     return reported_value(r, "peak_to_peak", _period(point))
 
 

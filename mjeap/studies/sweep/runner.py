@@ -110,7 +110,7 @@ def targeted_metrics(metrics: Sequence[str]) -> tuple:
     """The metrics an accuracy target applies to (:mod:`mjeap.simulation.metric_accuracy`):
     all the point's rollout metrics where each is one it answers (bookkeeping columns
     aside), else none (the target is then on the trajectory)."""
-    from ...simulation.metric_accuracy import BOOKKEEPING, answerable
+    from ...simulation.metric_scales import BOOKKEEPING, answerable
     return tuple(m for m in metrics if m not in BOOKKEEPING) if answerable(metrics) else ()
 
 
