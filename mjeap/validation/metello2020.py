@@ -116,78 +116,95 @@ def metello(quick: bool = False) -> Experiment:
                      f"Q fitted on {FIT_SAMPLE}", note="the coefficient is consistent across the samples")
         scene = Scene(act_id)
         act = scene.actuator
-        L = scene.layout.length
         EI = float(act.flexural_rigidity_at(0.0)[0])
         t_a = act.layers[active_layer(act)].thickness
-        # load-displacement: the beam's slope at 0 V and under the held fields (no stiffening)
-        slopes = []
-        for i, E in enumerate(FIELDS):
-            push, F, k, f = load_displacement(scene, E * t_a, EI)
-            slopes.append(k)
-            meas = SLOPES[act_id][i] * 1e3
-            tag = "0 V" if E == 0 else f"{E / 1e6:.2f} MV/m"
-            ex.check(f"{act_id} {tag}: load-displacement slope", "N/m", k, 3 * EI / L**3,
-                     f"{THESIS} eq. (3.12), z_m = W L^3 / (3 EI): slope 3 EI/L^3, EI the catalog's (identified from "
-                     "the measured 0 V slope with the same equation)", tolerance=0.02, kind=PUBLISHED_FORMULA,
-                     note=f"the simulated beam against eq. 3.12; field stiffening is off (factor {f:g}): switched on, "
-                          "it scales the beam to the measured slopes, and this row would compare the simulation with "
-                          "its own calibration")
-            if E == 0:
-                ex.check(f"{act_id} {tag}: layer model slope vs measured", "N/m",
-                         3 * act.section_at(0.0).flexural_rigidity / L**3, meas,
-                         f"{THESIS} Tables 4.1-4.3, measured (the catalog's EI is identified from it)",
-                         note="eqs. 3.1-3.6 (thesis Table 3.7) against the bench")
-                ex.check(f"{act_id} {tag}: slope vs thesis model", "N/m", k, MODEL_SLOPE[act_id] * 1e3,
-                         f"{THESIS} Tables 4.1-4.3, 'Model'")
-            else:
-                ex.check(f"{act_id} {tag}: slope vs measured", "N/m", k, meas, f"{THESIS} Tables 4.1-4.4, measured",
-                         note="the measured rise with field is not reproduced (stiffening off: not physics)")
-            ex.curve(f"{act_id}: load-displacement", f"mjeap {tag}", push * 1e3, F * 1e3,
-                     "tip push (mm)", "force (mN)", "o-")
-        ex.curve(f"{act_id}: slopes", "mjeap", FIELDS / 1e6, np.array(slopes) * 1e-3, "field (MV/m)", "slope (N/mm)", "o-")
-        ex.curve(f"{act_id}: slopes", f"{THESIS} measured", FIELDS / 1e6, SLOPES[act_id], "field (MV/m)",
-                 "slope (N/mm)", "s--")
-        # blocked force and free tip displacement per field (eigenstrain model, Q from FIT_SAMPLE)
-        free, blocked = [], []
-        for j, E in enumerate(FIELDS[1:]):
-            V = E * t_a
-            drv = held(scene, V)
-            M = drv.moment(V)
-            y_free = settle_tip(scene, 0.0)
-            compliance = (settle_tip(scene, 1e-4) - y_free) / 1e-4
-            Fb = -y_free / compliance
-            y_check = settle_tip(scene, Fb)
-            if j == len(FIELDS) - 2:
-                settle_tip(scene, 0.0)
-                ex.beam(f"{act_id}, {E / 1e6:.2f} MV/m, free", scene)
-            free.append(y_free)
-            blocked.append(-Fb)
-            tag = f"{E / 1e6:.2f} MV/m"
-            ex.check(f"{act_id} {tag}: blocked force / drive moment M", "1/m", -Fb / M, 1.5 / L,
-                     "Dadras et al. 2021 (seed 000) eq. (6), M = (2/3) l F: the uniform moment M is blocked by "
-                     "F = 3 M / (2 L)", tolerance=0.01, kind=PUBLISHED_FORMULA,
-                     note=f"M = {M:.4g} N m is the drive's (an input here: this row checks the beam's response to it, "
-                          f"not M); tip held at {abs(y_check) / abs(y_free):.1e} of the free deflection")
-            lo, hi = TABLE_6_1[act_id]
-            ex.check(f"{act_id} {tag}: blocked force vs measured (predicted)", "N", -Fb,
-                     0.5 * (lo + hi), f"{THESIS} Table 6.1 (range {lo:.3g}-{hi:.3g} N, mid-range shown)")
-            ex.check(f"{act_id} {tag}: free tip displacement / drive moment M", "m/(N m)", y_free / M,
-                     L**2 / (2 * EI), f"{THESIS} eq. (3.12) with the tip force W = 3 M / (2 L) of seed 000 eq. (6): "
-                     "L^2 / (2 EI), small deflection, EI the catalog's", tolerance=0.02, kind=PUBLISHED_FORMULA,
-                     note="M is the drive's (an input here); M(V) meets the measurements only in the comparison rows")
-            ex.check(f"{act_id} {tag}: free tip displacement vs measured ({role})", "m", y_free,
-                     TABLE_4_6[act_id][j], f"{THESIS} Table 4.6")
-            ex.check(f"{act_id} {tag}: free tip displacement vs COMSOL", "m", y_free, TABLE_5_3[act_id][j],
-                     f"{THESIS} Table 5.3 (COMSOL, stationary)")
-            ex.check(f"{act_id} {tag}: thesis Maxwell model F_y = M/L vs measured blocked force", "N",
-                     maxwell_stress_model(act, V)["tip_force"], 0.5 * (lo + hi),
-                     f"{THESIS} Table 6.1", note="eq. 3.11 with the layer-sum I of Table 3.7")
-        ex.curve(f"{act_id}: tip displacement", f"mjeap (eigenstrain, Q from {FIT_SAMPLE})", FIELDS[1:] / 1e6,
-                 np.array(free) * 1e3, "field (MV/m)", "tip displacement (mm)", "o-")
-        ex.curve(f"{act_id}: tip displacement", f"{THESIS} Table 4.6 measured", FIELDS[1:] / 1e6,
-                 np.array(TABLE_4_6[act_id]) * 1e3, "field (MV/m)", "tip displacement (mm)", "s--")
-        ex.curve(f"{act_id}: tip displacement", f"{THESIS} Table 5.3 COMSOL", FIELDS[1:] / 1e6,
-                 np.array(TABLE_5_3[act_id]) * 1e3, "field (MV/m)", "tip displacement (mm)", "^:")
+        _load_displacement(ex, act_id, scene, EI, t_a)
+        _driven(ex, act_id, scene, EI, t_a, role)
+    _notes(ex, q_fit)
+    return ex
+
+
+def _load_displacement(ex: Experiment, act_id: str, scene, EI: float, t_a: float) -> None:
+    """The rows of ``act_id``'s load-displacement: the beam's slope at 0 V and under the held
+    fields (no stiffening), against eq. (3.12), the layer model and the bench."""
+    act, L = scene.actuator, scene.layout.length
+    slopes = []
+    for i, E in enumerate(FIELDS):
+        push, F, k, f = load_displacement(scene, E * t_a, EI)
+        slopes.append(k)
+        meas = SLOPES[act_id][i] * 1e3
+        tag = "0 V" if E == 0 else f"{E / 1e6:.2f} MV/m"
+        ex.check(f"{act_id} {tag}: load-displacement slope", "N/m", k, 3 * EI / L**3,
+                 f"{THESIS} eq. (3.12), z_m = W L^3 / (3 EI): slope 3 EI/L^3, EI the catalog's (identified from "
+                 "the measured 0 V slope with the same equation)", tolerance=0.02, kind=PUBLISHED_FORMULA,
+                 note=f"the simulated beam against eq. 3.12; field stiffening is off (factor {f:g}): switched on, "
+                      "it scales the beam to the measured slopes, and this row would compare the simulation with "
+                      "its own calibration")
+        if E == 0:
+            ex.check(f"{act_id} {tag}: layer model slope vs measured", "N/m",
+                     3 * act.section_at(0.0).flexural_rigidity / L**3, meas,
+                     f"{THESIS} Tables 4.1-4.3, measured (the catalog's EI is identified from it)",
+                     note="eqs. 3.1-3.6 (thesis Table 3.7) against the bench")
+            ex.check(f"{act_id} {tag}: slope vs thesis model", "N/m", k, MODEL_SLOPE[act_id] * 1e3,
+                     f"{THESIS} Tables 4.1-4.3, 'Model'")
+        else:
+            ex.check(f"{act_id} {tag}: slope vs measured", "N/m", k, meas, f"{THESIS} Tables 4.1-4.4, measured",
+                     note="the measured rise with field is not reproduced (stiffening off: not physics)")
+        ex.curve(f"{act_id}: load-displacement", f"mjeap {tag}", push * 1e3, F * 1e3,
+                 "tip push (mm)", "force (mN)", "o-")
+    ex.curve(f"{act_id}: slopes", "mjeap", FIELDS / 1e6, np.array(slopes) * 1e-3, "field (MV/m)", "slope (N/mm)", "o-")
+    ex.curve(f"{act_id}: slopes", f"{THESIS} measured", FIELDS / 1e6, SLOPES[act_id], "field (MV/m)",
+             "slope (N/mm)", "s--")
+
+
+def _driven(ex: Experiment, act_id: str, scene, EI: float, t_a: float, role: str) -> None:
+    """The rows of ``act_id`` driven: blocked force and free tip displacement per field
+    (eigenstrain model, Q from FIT_SAMPLE) against the closed forms, the bench and COMSOL."""
+    act, L = scene.actuator, scene.layout.length
+    free, blocked = [], []
+    for j, E in enumerate(FIELDS[1:]):
+        V = E * t_a
+        drv = held(scene, V)
+        M = drv.moment(V)
+        y_free = settle_tip(scene, 0.0)
+        compliance = (settle_tip(scene, 1e-4) - y_free) / 1e-4
+        Fb = -y_free / compliance
+        y_check = settle_tip(scene, Fb)
+        if j == len(FIELDS) - 2:
+            settle_tip(scene, 0.0)
+            ex.beam(f"{act_id}, {E / 1e6:.2f} MV/m, free", scene)
+        free.append(y_free)
+        blocked.append(-Fb)
+        tag = f"{E / 1e6:.2f} MV/m"
+        ex.check(f"{act_id} {tag}: blocked force / drive moment M", "1/m", -Fb / M, 1.5 / L,
+                 "Dadras et al. 2021 (seed 000) eq. (6), M = (2/3) l F: the uniform moment M is blocked by "
+                 "F = 3 M / (2 L)", tolerance=0.01, kind=PUBLISHED_FORMULA,
+                 note=f"M = {M:.4g} N m is the drive's (an input here: this row checks the beam's response to it, "
+                      f"not M); tip held at {abs(y_check) / abs(y_free):.1e} of the free deflection")
+        lo, hi = TABLE_6_1[act_id]
+        ex.check(f"{act_id} {tag}: blocked force vs measured (predicted)", "N", -Fb,
+                 0.5 * (lo + hi), f"{THESIS} Table 6.1 (range {lo:.3g}-{hi:.3g} N, mid-range shown)")
+        ex.check(f"{act_id} {tag}: free tip displacement / drive moment M", "m/(N m)", y_free / M,
+                 L**2 / (2 * EI), f"{THESIS} eq. (3.12) with the tip force W = 3 M / (2 L) of seed 000 eq. (6): "
+                 "L^2 / (2 EI), small deflection, EI the catalog's", tolerance=0.02, kind=PUBLISHED_FORMULA,
+                 note="M is the drive's (an input here); M(V) meets the measurements only in the comparison rows")
+        ex.check(f"{act_id} {tag}: free tip displacement vs measured ({role})", "m", y_free,
+                 TABLE_4_6[act_id][j], f"{THESIS} Table 4.6")
+        ex.check(f"{act_id} {tag}: free tip displacement vs COMSOL", "m", y_free, TABLE_5_3[act_id][j],
+                 f"{THESIS} Table 5.3 (COMSOL, stationary)")
+        ex.check(f"{act_id} {tag}: thesis Maxwell model F_y = M/L vs measured blocked force", "N",
+                 maxwell_stress_model(act, V)["tip_force"], 0.5 * (lo + hi),
+                 f"{THESIS} Table 6.1", note="eq. 3.11 with the layer-sum I of Table 3.7")
+    ex.curve(f"{act_id}: tip displacement", f"mjeap (eigenstrain, Q from {FIT_SAMPLE})", FIELDS[1:] / 1e6,
+             np.array(free) * 1e3, "field (MV/m)", "tip displacement (mm)", "o-")
+    ex.curve(f"{act_id}: tip displacement", f"{THESIS} Table 4.6 measured", FIELDS[1:] / 1e6,
+             np.array(TABLE_4_6[act_id]) * 1e3, "field (MV/m)", "tip displacement (mm)", "s--")
+    ex.curve(f"{act_id}: tip displacement", f"{THESIS} Table 5.3 COMSOL", FIELDS[1:] / 1e6,
+             np.array(TABLE_5_3[act_id]) * 1e3, "field (MV/m)", "tip displacement (mm)", "^:")
+
+
+def _notes(ex: Experiment, q_fit: float) -> None:
+    """What the experiment's rows say together (the model used, what no model reproduces)."""
     qs = {a: fit_strain_coefficient(a) for a in SAMPLES}
     low = [c.error for c in ex.checks if "8.33 MV/m: free tip displacement vs measured" in c.quantity]
     high = [c.error for c in ex.checks if "15.00 MV/m: free tip displacement vs measured" in c.quantity]
@@ -218,4 +235,3 @@ def metello(quick: bool = False) -> Experiment:
         "blocked at the tip gives 3M/(2L). Load-displacement is run as the thesis does (push 0.5-4 mm in 0.5 mm "
         "steps, force read) by settling under prescribed forces and interpolating the force at each push.",
     ]
-    return ex
