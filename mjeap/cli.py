@@ -69,14 +69,27 @@ def drive_rows(a) -> dict:
     return {"name": name, "model": cls.model_used, "parameters": rows}
 
 
+#: the designer's first numbers `mjeap show` prints (and --json keys), in this order
+DESIGN_KEYS = ("first_frequency", "free_deflection", "blocked_force", "capacitance", "blocked_capacitance",
+               "energy_density", "mass")
+#: which capacitance a datasheet gives, and what Jayaram et al. 2018 measured (section 3)
+CAPACITANCE_NOTE = ("a datasheet's permittivity eps33^T (constant stress) gives the free capacitance; Jayaram et al. "
+                    "2018 measured the fixed (blocked) capacitance of Type II at less than half the 16 nF that value "
+                    "gives (section 3)")
+
+
 def describe(name: str) -> dict:
     """Every parameter of an actuator (catalog id or file) with unit and provenance, its
-    drive's parameters with theirs, plus derived values."""
+    drive's parameters with theirs, derived values and the designer's first numbers
+    (:data:`DESIGN_KEYS`, :func:`mjeap.design.design_numbers`)."""
+    from .design import design_numbers
     from .model import analytical
+    from .model.laminate import piezo_layers
     from .simulation.scene import Scene
     a = _actuator(name)
+    piezo = {p.index: p for p in piezo_layers(a)}
     layers = []
-    for l in a.layers:
+    for i, l in enumerate(a.layers):
         layers.append({
             "name": l.name, "material": l.material,
             "thickness": (l.thickness, "m", l.provenance("thickness")),
@@ -85,6 +98,14 @@ def describe(name: str) -> dict:
             "poisson_ratio": (l.poisson_ratio, "-", l.provenance("poisson_ratio")),
             "density": (l.density, "kg/m^3", l.provenance("density")),
         })
+        pz = piezo.get(i)
+        if pz is not None and a.drive == "piezo":
+            layers[-1].update({
+                "d31": (pz.d31, "m/V", pz.sources.get("d31", "none given")),
+                "relative_permittivity": (pz.relative_permittivity, "-", pz.sources.get("relative_permittivity",
+                                                                                         "none given")),
+                "electrode": (pz.electrode, "-", "signal: V; complement: bias - V"),
+                "poling": (pz.poling, "-", "the sign of the free strain d31 V / t")})
     p = a.planform
     sec = a.section_at(0.0)
     EI0 = float(a.flexural_rigidity_at(0.0)[0])
@@ -93,7 +114,9 @@ def describe(name: str) -> dict:
     f1_formula = float(analytical.natural_frequencies(a.length, EI0, mu, n=1)[0]) if uniform else None
     scene = Scene(a)
     c = scene.choice
+    numbers = design_numbers(a)
     return {
+        **{k: numbers[k] for k in DESIGN_KEYS}, "warnings": numbers["warnings"],
         "id": a.id, "title": a.title, "document": a.document, "file": _actuator_file_of(a), "layers": layers,
         "planform": {"length": (p.length, "m", p.source), "base_width": (p.base_width, "m", p.source),
                      "tip_width": (p.tip_width, "m", p.source),
@@ -111,7 +134,8 @@ def describe(name: str) -> dict:
             "flexural_rigidity_tip": (float(a.flexural_rigidity_at(a.length)[0]), "N m^2", ""),
             "neutral_axis": (sec.neutral_axis, "m from the bottom face", "multilayer_section"),
             "thickness": (a.thickness, "m", ""),
-            "mass": (a.total_mass(), "kg", "measured" if a.mass else "layers x planform"),
+            "mass": (numbers["mass"][0], "kg", ("measured beam" if a.mass else "layers x planform")
+                     + " and the rigid tip block (as the mass metric and mass above)"),
             "first_frequency_uniform_beam": (f1_formula, "Hz", "Euler-Bernoulli" if uniform else "tapered: n/a"),
             "first_frequency_model": (c.first_frequency, "Hz", f"MuJoCo hinge chain, {scene.layout.segments} segments"),
             "highest_frequency_model": (c.highest_frequency, "Hz", "highest discrete mode"),
@@ -126,12 +150,18 @@ def cmd_show(args) -> int:
     if args.json:
         print(json.dumps(d, indent=2, default=str))
         return 0
+    for w in d["warnings"]:
+        print(f"mjeap: warning: {w}", file=sys.stderr)
     print(f"{d['id']}: {d['title']}\n  source: {d['document']}\n  file: {d['file']}\n\nlayers (bottom to top):")
     for l in d["layers"]:
         print(f"  {l['name']} ({l['material']})")
-        for k in ("thickness", "width", "youngs_modulus", "poisson_ratio", "density"):
+        for k in ("thickness", "width", "youngs_modulus", "poisson_ratio", "density", "d31",
+                  "relative_permittivity", "electrode", "poling"):
+            if k not in l:
+                continue
             v, u, s = l[k]
-            print(f"    {k:<16} {v if isinstance(v, str) else _fmt(v):>12} {u:<7} {s}")
+            v = "-" if v is None else v
+            print(f"    {k:<21} {v if isinstance(v, str) else _fmt(v):>12} {u:<7} {s}")
 
     def block(title, items):
         print(f"\n{title}:")
@@ -139,6 +169,9 @@ def cmd_show(args) -> int:
             vs = "-" if v is None else (_fmt(v) if isinstance(v, float) else str(v))
             print(f"  {k:<30} {vs:>12} {u:<8} {s}")
 
+    block("at the voltage range (closed forms, no rollout)", {k: d[k] for k in DESIGN_KEYS})
+    if d["capacitance"][0] is not None:
+        print(f"  ({CAPACITANCE_NOTE})")
     block("planform", d["planform"])
     if d["overrides"]:
         block("identified values (override the layers)", d["overrides"])

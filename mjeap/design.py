@@ -32,7 +32,7 @@ from typing import Dict, List, Mapping, Optional
 
 from .errors import ParameterError, UnknownNameError
 
-__all__ = ["PREFIX", "PLANFORM", "LAYER_FIELDS", "is_design_parameter", "design_parameter_names",
+__all__ = ["PREFIX", "PLANFORM", "LAYER_FIELDS", "is_design_parameter", "design_parameter_names", "design_numbers",
            "check_design_value", "check_design", "design_actuator", "get_base", "parameter_unit", "to_value", "DESIGN_SOURCE"]
 
 PREFIX = "actuator."
@@ -285,3 +285,63 @@ def _quiet_check(name, v, act):
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         return check_design_value(name, v, act)
+
+
+# ---------------------------------------------------------------- a design's first numbers
+#: how far the catalog bimorphs' physical parameter set (their files without the fitted
+#: residual tip mass) resonates above the f_r Jayaram et al. 2018 measured (Table 1), the
+#: linearised model's f1 / f_r - 1 (tests/test_piezo_laminate.py recomputes it)
+PHYSICAL_SET_F1_GAP = {"pzt-hamr-small": 0.077, "pzt-hamr-large": 0.358, "pzt-robobee": 0.748}
+F1_NOTE = ("from the physical parameter set, no residual tip mass fitted to a measurement: that set resonated "
+           f"{min(PHYSICAL_SET_F1_GAP.values()):.0%} to {max(PHYSICAL_SET_F1_GAP.values()):.0%} above the three measured "
+           "catalog types (Jayaram et al. 2018, Table 1; the catalog closes the gap with a fitted residual tip mass): "
+           "expect the real part lower")
+MASS_NOTE = "the beam's layers and its rigid tip block (extension and residual mass), as the mass metric"
+
+
+def design_numbers(actuator, *, segments: Optional[int] = None) -> Dict[str, object]:
+    """A designer's first numbers for ``actuator`` (catalog id, file or Actuator) at its
+    drive's voltage range, from closed forms and the linearised model (no rollout), each
+    (value SI, unit, how): ``first_frequency`` (the linearised model's, as the metric),
+    ``free_deflection`` and ``blocked_force`` (their swings over the range: the quasi-static
+    tip deflection and the force at the tip block's end that holds it, small deflections),
+    ``capacitance`` (free) and ``blocked_capacitance`` (the dielectric term of the current),
+    ``energy_density`` (blocked_force x free_deflection / (2 mass)) and ``mass`` (beam and tip
+    block). The piezo numbers are None for a drive without a laminate; ``warnings`` lists the
+    fields past a layer's limits."""
+    from .drives import make_drive
+    from .drives.piezo import LinearPiezo
+    from .simulation.scene import DEFAULT_SEGMENTS, Scene
+    act = get_base(actuator)
+    scene = Scene(act, segments=segments or DEFAULT_SEGMENTS)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        drv = make_drive(None, scene)
+    out: Dict[str, object] = {"warnings": [str(w.message) for w in caught]}
+    p = act.planform
+    piezo = isinstance(drv, LinearPiezo)
+    how = f"linearised model, {scene.layout.segments} segments"
+    if piezo and p.residual_tip_mass == 0:
+        how += "; " + F1_NOTE
+    out["first_frequency"] = (float(scene.choice.first_frequency), "Hz", how)
+    mass = float(act.total_mass() + p.tip_block_mass)
+    out["mass"] = (mass, "kg", MASS_NOTE)
+    lo, hi = drv.voltage_range()
+    if not piezo:
+        none = f"n/a: the {drv.name} drive has no laminate closed form"
+        for k, u in (("free_deflection", "m"), ("blocked_force", "N"), ("capacitance", "F"),
+                     ("blocked_capacitance", "F"), ("energy_density", "J/kg")):
+            out[k] = (None, u, none)
+        return out
+    lam = drv.laminate()
+    free = abs(lam.free_deflection(hi) - lam.free_deflection(lo))
+    force = free / lam.tip_compliance()
+    rng = f"over the voltage range [{lo:g}, {hi:g}] V"
+    out["free_deflection"] = (free, "m", f"peak to peak {rng}: int kappa (L + l_e - x) dx, kappa = M(x, V) / EI(x)")
+    out["blocked_force"] = (force, "N", f"peak to peak {rng} at the tip block's end: free deflection / tip compliance")
+    caps = drv.capacitances()
+    out["capacitance"] = (float(caps["free"][0]), "F", caps["free"][1])
+    out["blocked_capacitance"] = (float(caps["blocked"][0]), "F", caps["blocked"][1])
+    out["energy_density"] = (force * free / (2.0 * mass), "J/kg", "blocked_force x free_deflection / (2 mass), "
+                             "the swings over the range")
+    return out

@@ -275,20 +275,21 @@ class PiezoBimorphDrive(LinearPiezo):
         (V_sig), the top one on the complement (V_bias - V_sig), both poled up; no
         permittivity (the file gives a capacitance instead)."""
         from ..model.laminate import Laminate, PiezoLayer
-        act = self.scene.actuator
-        idx = [i for i, l in enumerate(act.layers) if l.role == "piezo"]
-        src = {"d31": "equivalent: -f31 / youngs_modulus (piezo-bimorph's effective stress per field)"}
-        layers = [PiezoLayer(i, act.layers[i].name, -self.params["f31"] / act.layers[i].youngs_modulus, None,
-                             "signal" if k == 0 else "complement", "up", src, act.layers[i].material_key)
-                  for k, i in enumerate(idx)]
-        return Laminate(act, layers, self.params["bias"])
+        if getattr(self, "_laminate", None) is None:
+            act = self.scene.actuator
+            idx = [i for i, l in enumerate(act.layers) if l.role == "piezo"]
+            src = {"d31": "equivalent: -f31 / youngs_modulus (piezo-bimorph's effective stress per field)"}
+            layers = [PiezoLayer(i, act.layers[i].name, -self.params["f31"] / act.layers[i].youngs_modulus, None,
+                                 "signal" if k == 0 else "complement", "up", src, act.layers[i].material_key)
+                      for k, i in enumerate(idx)]
+            self._laminate = Laminate(act, layers, self.params["bias"])
+        return self._laminate
 
     def capacitances(self):
-        """Free: the model's low-frequency charge per volt C + sum_j Gamma_j^2 / k_j (the
-        file has no permittivity: C + Gamma^2 int dx / EI); blocked: C, the dielectric term."""
-        lay = self.scene.layout
+        """Free: the model's low-frequency charge per volt C + Gamma^2 int dx / EI (the file
+        has no permittivity); blocked: C, the dielectric term of the current."""
         c = float(self.params["capacitance"])
-        return {"free": (c + float(np.sum(self.gamma ** 2 / lay.hinge_stiffness)),
+        return {"free": (c + self.laminate().bending_charge_per_volt(),
                          "model's low-frequency charge per volt, C + Gamma^2 int dx/EI (no permittivity in the file)"),
                 "blocked": (c, "the capacitance parameter: the dielectric (blocked) term of the current")}
 

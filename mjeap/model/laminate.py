@@ -317,11 +317,17 @@ class Laminate:
         inextensible beam model gives), ``laminate`` (beam + int (dN/dV)^2 / (sum Y w t) dx:
         free to stretch too) and ``free`` (:meth:`free_capacitance`)."""
         x, w = self._along()
-        g = np.array([self.moment(xi)[0] for xi in x])
         n = np.array([self.stretch(xi)[0] for xi in x])
         ea = np.array([float(np.sum(np.asarray(s.layer_moduli) * np.asarray(s.layer_widths)
                                     * np.diff(np.asarray(s.interfaces)))) for s in map(self._section, x)])
         clamped = self.clamped_capacitance()
-        beam = clamped + float(np.sum(w * g ** 2 / self.actuator.flexural_rigidity_at(x)))
+        beam = clamped + self.bending_charge_per_volt()
         return {"clamped": clamped, "beam": beam, "laminate": beam + float(np.sum(w * n ** 2 / ea)),
                 "free": self.free_capacitance()}
+
+    def bending_charge_per_volt(self) -> float:
+        """The motional charge per volt (F) of the free beam at rest under a static voltage:
+        int (dM/dV)^2 / EI dx (reciprocity: the charge Gamma theta of the rotation Gamma V / k)."""
+        x, w = self._along()
+        g = np.array([self.moment(xi)[0] for xi in x])
+        return float(np.sum(w * g ** 2 / self.actuator.flexural_rigidity_at(x)))
