@@ -14,7 +14,7 @@ LAYER_FILES = {
     "model": ("test_section", "test_analytical", "test_lti", "test_statics", "test_dynamics", "test_axial",
               "test_rod", "test_assets", "test_actuator_files"),
     "drives": ("test_drive_ionic", "test_drive_electrostatic", "test_drive_allocation", "test_piezo_moment",
-               "test_piezo_power", "test_pvdf_fidelity"),
+               "test_piezo_power", "test_pvdf_fidelity", "test_piezo_laminate"),
     "engines": ("test_threaded", "test_native", "test_warp"),
     "simulation": ("test_rollout", "test_system", "test_pipeline", "test_accuracy", "test_periodic", "test_golden",
                    "test_viewer"),

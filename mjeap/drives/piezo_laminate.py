@@ -124,9 +124,6 @@ class PiezoLaminateDrive(LinearPiezo):
     @classmethod
     def stack_reason(cls, actuator) -> Optional[str]:
         """At least one piezo layer, each with its constants (:func:`laminate_reason`)."""
-        why = super().stack_reason(actuator)
-        if why is not None:
-            return why
         own = actuator.drive == cls.name          # a file of this drive: its bias is all there is
         bias = actuator.drive_parameters.get("bias", (None,))[0] if own else None
         return laminate_reason(actuator, bias, need_bias=own)
