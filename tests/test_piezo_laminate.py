@@ -352,3 +352,19 @@ def test_the_physical_sets_f1_gap_the_docs_state():
         a = CATALOG[aid]
         bare = dataclasses.replace(a, planform=dataclasses.replace(a.planform, residual_tip_mass=0.0))
         assert Scene(bare).choice.first_frequency / fr - 1 == pytest.approx(PHYSICAL_SET_F1_GAP[aid], abs=1e-3)
+
+
+@pytest.mark.parametrize("name", ["pzt-unimorph", "asymmetric-bimorph", "multilayer-bender"])
+def test_every_engine_runs_a_laminate_as_the_loop_does(name):
+    """The drive's native form (one actuator on the bending tendon) and its open-loop form
+    (the threaded engine) give the loop's tip and current; auto picks one of them."""
+    runs = {}
+    for engine in ("loop", "threaded", "native", "auto"):
+        runs[engine] = rollout(Scene(str(EXAMPLES / f"{name}.toml")), "sine:30V@200Hz,offset=50V", 0.01,
+                               engine=engine, progress=False)
+    assert runs["auto"].meta["engine"] in ("native", "threaded")
+    ref = runs["loop"]
+    for engine in ("threaded", "native"):
+        for a, b in ((runs[engine].tip_position[:, 1], ref.tip_position[:, 1]),
+                     (runs[engine].signals["current (A)"], ref.signals["current (A)"])):
+            assert np.max(np.abs(a - b)) <= 1e-9 * np.ptp(b), engine
