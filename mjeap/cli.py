@@ -541,7 +541,7 @@ def cmd_optimize(args) -> int:
                  voltage=args.voltage, duration=args.duration, base=base,
                  metrics=[m for m in (args.metrics or "").split(",") if m], method=args.method, starts=args.starts,
                  seed=args.seed, max_evaluations=args.max_evaluations, out=args.out,
-                 progress=False if args.quiet else None)
+                 progress=False if args.quiet else None, pareto=args.pareto, pareto_points=args.pareto_points)
     print(json.dumps(r.as_dict(), indent=2, default=float))
     if not r.success:
         print(f"mjeap optimize: {r.message}", file=sys.stderr)
@@ -659,8 +659,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0, help="seed of the random design")
     p.add_argument("--metrics", default="peak_to_peak,returns",
                    help="comma list: peak_to_peak, returns, settling_time, max_stress_proxy, max_tip_deflection, "
-                        "first_frequency, mass, free_deflection, blocked_force, energy_density, peak_power, "
-                        "energy_per_cycle")
+                        "first_frequency, mass, free_deflection, blocked_force, energy_density (a step's), stroke (a "
+                        "periodic drive's), peak_power, energy_per_cycle, max_field, max_reverse_field, max_stress, "
+                        "capacitance (piezo drives)")
     p.add_argument("--out", default="out/sweep.csv", help="results CSV (appended; finished points are skipped)")
     from .sweep import EXECUTORS
     p.add_argument("--executor", choices=EXECUTORS, default="processes")
@@ -677,10 +678,14 @@ def build_parser() -> argparse.ArgumentParser:
                         "actuator.roles.piezo.thickness=100um:150um, drive.bias=100:200, payload_mass=0:5mg (repeatable)")
     goal = p.add_mutually_exclusive_group(required=True)
     goal.add_argument("--maximize", metavar="METRIC", help="the metric to maximise (free_deflection, blocked_force, "
-                      "energy_density, first_frequency, ...)")
-    goal.add_argument("--minimize", metavar="METRIC", help="the metric to minimise (mass, peak_power, ...)")
+                      "energy_density, stroke, first_frequency, ...)")
+    goal.add_argument("--minimize", metavar="METRIC", help="the metric to minimise (mass, peak_power, max_field, ...)")
+    goal.add_argument("--pareto", metavar="M1,M2", help="trace the front between two metrics (each maximised; "
+                      "min:NAME minimises), e.g. free_deflection,blocked_force: pareto.csv and pareto.png")
+    p.add_argument("--pareto-points", type=int, default=7, help="points of the front (default 7)")
     p.add_argument("--subject-to", action="append", metavar="EXPR",
-                   help='a constraint "METRIC>=VALUE" or "METRIC<=VALUE" (SI or with a unit; repeatable)')
+                   help='a constraint "METRIC>=VALUE" or "METRIC<=VALUE", SI or with the metric\'s unit: '
+                        '"first_frequency>=800Hz", "max_field<=1V/um" (repeatable)')
     p.add_argument("--voltage", help="waveform of the rollouts the metrics need: step:200V, sine:50V@100Hz,offset=100V")
     p.add_argument("--duration", type=float, help="simulated time of each rollout (s; a step needs one)")
     p.add_argument("--set", action="append", metavar="NAME=VALUE",
@@ -694,7 +699,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0, help="seed of the starts / the evolution")
     p.add_argument("--max-evaluations", type=int, default=400, help="at most this many evaluations (default 400)")
     p.add_argument("--out", default="out/optimize",
-                   help="folder for result.json, evaluations.csv (a rerun reads it as a cache) and optimum.toml")
+                   help="folder for result.json, evaluations.csv (a rerun reads it as a cache), optimum.toml and, with "
+                        "the report extra, optimize.png (and pareto.csv, pareto.png)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_optimize)
     p = sub.add_parser("identify", help="fit the papers' models to measured data (CSV with a header)")
