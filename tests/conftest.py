@@ -20,6 +20,7 @@ LAYER_FILES = {
                    "test_viewer"),
     "analysis": ("test_identify", "test_self_sensing", "test_stability_map"),
     "applications": ("test_sweep", "test_metric_accuracy", "test_design_sweeps", "test_optimize", "test_actuator_cli",
+                     "test_design_piezo",
                      "test_validation",
                      "test_controllers", "test_hamr_leg", "test_environment", "test_gymnasium_env"),
     "robots": ("test_robots", "test_gripper", "test_hamr_leg_linkage", "test_robobee_wing", "test_hamr_walk",
