@@ -314,9 +314,13 @@ def design_numbers(actuator, *, segments: Optional[int] = None) -> Dict[str, obj
     from .simulation.scene import DEFAULT_SEGMENTS, Scene
     act = get_base(actuator)
     scene = Scene(act, segments=segments or DEFAULT_SEGMENTS)
+    why = ""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
-        drv = make_drive(None, scene)
+        try:
+            drv = make_drive(None, scene)
+        except ParameterError as e:       # a parameter a run must give: the mechanics still answer
+            drv, why = None, f"n/a: the drive needs {e}"
     out: Dict[str, object] = {"warnings": [str(w.message) for w in caught]}
     p = act.planform
     piezo = isinstance(drv, LinearPiezo)
@@ -326,13 +330,13 @@ def design_numbers(actuator, *, segments: Optional[int] = None) -> Dict[str, obj
     out["first_frequency"] = (float(scene.choice.first_frequency), "Hz", how)
     mass = float(act.total_mass() + p.tip_block_mass)
     out["mass"] = (mass, "kg", MASS_NOTE)
-    lo, hi = drv.voltage_range()
     if not piezo:
-        none = f"n/a: the {drv.name} drive has no laminate closed form"
+        none = why or f"n/a: the {drv.name} drive has no laminate closed form"
         for k, u in (("free_deflection", "m"), ("blocked_force", "N"), ("capacitance", "F"),
                      ("blocked_capacitance", "F"), ("energy_density", "J/kg")):
             out[k] = (None, u, none)
         return out
+    lo, hi = drv.voltage_range()
     lam = drv.laminate()
     free = abs(lam.free_deflection(hi) - lam.free_deflection(lo))
     force = free / lam.tip_compliance()

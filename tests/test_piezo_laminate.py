@@ -169,7 +169,6 @@ def test_first_frequency_capacitance_and_fields_against_closed_forms(tmp_path, c
     assert row["max_reverse_field"] == pytest.approx(reverse, rel=1e-9, abs=1e-9)
 
 
-@pytest.mark.slow
 @pytest.mark.parametrize("case", ["unimorph", "asymmetric-bimorph"])
 def test_stroke_of_a_slow_sine_is_the_quasi_static_stroke(tmp_path, case):
     """A sine at f1 / 40 from its offset, heavily damped (zeta 0.5, the start's ringing gone
