@@ -45,6 +45,11 @@ SLSQP (3 starts) and differential evolution, evaluations, wall and their error a
 beside them the grid sweep of the same two metrics whose spacing is the 1 % the test asks of
 the optimiser (2 workers), its best feasible point's error and wall, and the number of grid
 points a sweep would need to match each optimiser's own error.
+
+show: mjeap show's time per file (the catalog and examples/actuators): the first describe()
+of each file in one process (the designer's first numbers from closed forms and the
+linearised model, the scene built) and the best of three more; and the whole command in a
+fresh process, beside importing the package alone (what a cold start costs).
 """
 import argparse
 import json
@@ -128,15 +133,20 @@ def bench_rollout(tmpdir):
             "fine": {"timestep_s": fine.timestep, "segments": fine.layout.segments}}
 
 
+#: drives no catalog actuator uses, timed on an example file
+EXAMPLE_ACTUATORS = {"piezo": "examples/actuators/laminate/pzt-hamr-small.toml"}
+
+
 def bench_drives(n=20000):
     """Drive step cost (us), 20 hinges, the voltage alternating every step (worst case for
     drives that cache on it)."""
     from mjeap.drives import DRIVES, make_drive
     rows = []
     for name, cls in DRIVES.items():
-        if not cls.actuators:           # a drive no catalog actuator uses ('none'): nothing to time
+        example = EXAMPLE_ACTUATORS.get(name)
+        if not cls.actuators and example is None:   # a drive no actuator uses ('none'): nothing to time
             continue
-        s = Scene(cls.actuators[0])
+        s = Scene(cls.actuators[0] if cls.actuators else str(Path(__file__).resolve().parent.parent / example))
         drv = make_drive(name, s)
         drv.reset(0.0)
         lo, hi = drv.voltage_range()
@@ -150,6 +160,37 @@ def bench_drives(n=20000):
                      "step_us": (time.perf_counter() - t0) / n * 1e6,
                      "open_loop": drv.closed_loop_reason() is None})
     return rows
+
+
+def bench_show(repeats=3):
+    """mjeap show per file (module text): seconds of describe() first and warm, and of the
+    command in a fresh process beside the import alone."""
+    import subprocess
+    from mjeap.cli import describe
+    from mjeap.model.catalog import CATALOG
+    root = Path(__file__).resolve().parent.parent
+    files = list(CATALOG) + sorted(str(p.relative_to(root)) for p in (root / "examples" / "actuators").rglob("*.toml"))
+    rows = []
+    for f in files:
+        t0 = time.perf_counter()
+        describe(str(root / f) if f.endswith(".toml") else f)
+        first = time.perf_counter() - t0
+        again = []
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            describe(str(root / f) if f.endswith(".toml") else f)
+            again.append(time.perf_counter() - t0)
+        rows.append({"file": f, "first_s": first, "again_s": min(again)})
+    cold = {}
+    for what, argv in (("import_s", [sys.executable, "-c", "import mjeap.cli"]),
+                       ("command_s", [sys.executable, "-m", "mjeap.cli", "show", "pzt-hamr-small"])):
+        best = []
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            subprocess.run(argv, cwd=root, check=True, capture_output=True)
+            best.append(time.perf_counter() - t0)
+        cold[what] = min(best)
+    return {"files": rows, "fresh_process": {"file": "pzt-hamr-small", **cold}}
 
 
 def bench_threaded():
@@ -718,7 +759,7 @@ def bench_warp(map_points=4, duration=1.0, batch=16, batch_duration=0.6):
 
 
 BENCHMARKS = ("models", "rollout", "drives", "threaded", "elastica", "sweep", "native", "accuracy", "metric_map",
-              "early_stop", "optimize", "warp")
+              "early_stop", "optimize", "warp", "show")
 
 
 def main(argv=None):
@@ -772,6 +813,8 @@ def main(argv=None):
             out["optimize"] = bench_optimize()
         elif name == "warp":
             out["warp"] = bench_warp()
+        elif name == "show":
+            out["show"] = bench_show()
         emit()
     print(emit())
 
