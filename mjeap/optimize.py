@@ -36,8 +36,9 @@ change of constraint k's bound, and nu_i = d f* / d (bound of variable i).
 with M2 held at ``pareto_points - 2`` levels between them (each started from the previous
 optimum), under the same constraints and budget; it is written to ``pareto.csv`` and, with
 the ``report`` extra, ``pareto.png``. With the ``report`` extra every optimisation draws
-``optimize.png``: the objective and each constraint's metric over each variable at every
-evaluation, the optimum and the active bounds marked.
+``optimize.png``: the objective and each constraint's metric over each variable, swept through
+the optimum (``slice_points`` evaluations each, the other variables held) over every
+evaluation of the search, the optimum, the constraints' bounds and the active bounds marked.
 """
 from __future__ import annotations
 
@@ -187,6 +188,8 @@ class OptimizeResult:
     pareto: Optional[List[dict]] = None
     #: every evaluation: (point, {metric: value}, error) for the figures
     evaluated: List[tuple] = field(default_factory=list, repr=False)
+    #: each variable swept through the optimum, the others held: name -> evaluations as above
+    slices: Dict[str, List[tuple]] = field(default_factory=dict, repr=False)
 
     def as_dict(self) -> dict:
         d = {k: getattr(self, k) for k in ("optimum", "metrics", "objective", "constraints", "sensitivities",
@@ -430,7 +433,7 @@ def optimize(actuator, vary: Mapping[str, object], maximize: Optional[str] = Non
              seed: int = 0, max_evaluations: int = 400, out=None, progress: Optional[bool] = None,
              tol: float = 1e-7, fd_step: float = 1e-3, feasibility: float = 1e-6, active: float = 1e-3,
              maxiter: int = 100, popsize: int = 10, de_tol: float = 1e-2, pareto=None,
-             pareto_points: int = 7) -> OptimizeResult:
+             pareto_points: int = 7, slice_points: int = 11) -> OptimizeResult:
     """Maximise (``maximize``) or minimise (``minimize``) one metric of :mod:`mjeap.sweep`
     over the box ``vary`` (name -> (low, high), SI numbers or texts with units, or
     ``"LOW:HIGH"``; names ``actuator.X`` of :mod:`mjeap.design`, ``drive.NAME``,
@@ -456,7 +459,9 @@ def optimize(actuator, vary: Mapping[str, object], maximize: Optional[str] = Non
     ``pareto``: ``"M1,M2"`` or (M1, M2), each maximised or, prefixed ``min:``, minimised,
     instead of ``maximize``/``minimize``: the front between them at ``pareto_points`` points
     (module text), in ``pareto.csv`` and ``pareto.png``; the optimum reported is the best M1.
-    With the ``report`` extra (matplotlib) ``optimize.png`` shows the search (module text)."""
+    With the ``report`` extra (matplotlib) ``optimize.png`` shows the search (module text).
+    ``slice_points``: evaluations of each variable swept through the optimum, the others
+    held (the figure's lines; 0: none), within the budget and written as the others are."""
     from . import design
     from .io.outputs import check_outputs, hold, replacing
     from .sweep import METRICS, STATIC_METRICS, check_metric_settings, check_settings
@@ -492,6 +497,7 @@ def optimize(actuator, vary: Mapping[str, object], maximize: Optional[str] = Non
     seed = check_integer("seed", seed, 0)
     max_evaluations = check_integer("max_evaluations", max_evaluations, 2)
     popsize = check_integer("popsize", popsize, 4, 1000)
+    slice_points = check_integer("slice_points", slice_points, 0, 1000)
     maxiter = check_integer("maxiter", maxiter, 1)
     fd_step = check_range("fd_step", fd_step, 0.0, 0.1, "(of the box)", lo_open=True)
     tol = check_range("tol", tol, 0.0, 0.1, lo_open=True)
@@ -548,7 +554,7 @@ def optimize(actuator, vary: Mapping[str, object], maximize: Optional[str] = Non
             if folder is None:
                 return _run(names, lo, hi, wanted, fixed, {}, None, columns, max_evaluations, progress, objective,
                             sign, constraints, feasibility, method, starts, seed, tol, fd_step, maxiter, popsize,
-                            active, base_name, t0, files, act0, de_tol, front, pareto_points)
+                            active, base_name, t0, files, act0, de_tol, front, pareto_points, slice_points)
             csv_path = files["evaluations"]
             with hold(csv_path, "--out (evaluations.csv)", holder="mjeap optimize"):
                 _drop_torn_row(csv_path)
@@ -565,7 +571,7 @@ def optimize(actuator, vary: Mapping[str, object], maximize: Optional[str] = Non
                         writer.write(columns, 0)
                     result = _run(names, lo, hi, wanted, fixed, cached, writer, columns, max_evaluations, progress,
                                   objective, sign, constraints, feasibility, method, starts, seed, tol, fd_step,
-                                  maxiter, popsize, active, base_name, t0, files, act0, de_tol, front, pareto_points)
+                                  maxiter, popsize, active, base_name, t0, files, act0, de_tol, front, pareto_points, slice_points)
                 finally:
                     writer.close()
             if result.actuator is not None:
@@ -640,7 +646,7 @@ def _search(ev: _Evaluations, method, starts, seed, tol, fd_step, maxiter, popsi
 
 def _run(names, lo, hi, wanted, fixed, cached, writer, columns, max_evaluations, progress, objective, sign,
          constraints, feasibility, method, starts, seed, tol, fd_step, maxiter, popsize, active, base_name, t0,
-         files, act0, de_tol=1e-2, pareto=None, pareto_points=7) -> OptimizeResult:
+         files, act0, de_tol=1e-2, pareto=None, pareto_points=7, slice_points=11) -> OptimizeResult:
     bar = None
     if progress or (progress is None and sys.stderr.isatty()):
         try:
@@ -676,6 +682,7 @@ def _run(names, lo, hi, wanted, fixed, cached, writer, columns, max_evaluations,
                      "margin": c.margin(v), "met": c.margin(v) >= -feasibility, "active": abs(c.margin(v)) <= active})
     feasible = ev.best is not None
     sensitivities = _sensitivities(ev, row, constraints, active, fd_step, base_name) if feasible else []
+    slices = _slices(ev, ev.u_of(point), slice_points)
     act = None
     try:
         from .design import design_actuator
@@ -703,7 +710,28 @@ def _run(names, lo, hi, wanted, fixed, cached, writer, columns, max_evaluations,
         message="; ".join(dict.fromkeys(messages)) + ("" if feasible else "; no feasible point found: the least "
                                                        "infeasible is reported"),
         method=method, wall_s=time.perf_counter() - t0, runs=runs, actuator=act,
-        files={k: str(v) for k, v in files.items()}, sensitivities=sensitivities, pareto=front, evaluated=evaluated)
+        files={k: str(v) for k, v in files.items()}, sensitivities=sensitivities, pareto=front, evaluated=evaluated,
+        slices=slices)
+
+
+def _slices(ev: _Evaluations, u: np.ndarray, points: int) -> Dict[str, List[tuple]]:
+    """Each variable swept over its range through the optimum (the others held there):
+    name -> [(point, {metric: value}, error)]; where the budget runs out, what was reached."""
+    out: Dict[str, List[tuple]] = {}
+    if points < 2:
+        return out
+    for i, name in enumerate(ev.names):
+        rows = []
+        for ui in np.linspace(0.0, 1.0, points):
+            v = u.copy()
+            v[i] = ui
+            try:
+                r = ev(v)
+            except _Budget:
+                break
+            rows.append((r["_point"], {m: _clean(r.get(m, "")) for m in ev.metrics}, r.get("error", "")))
+        out[name] = rows
+    return out
 
 
 def _trace_front(ev: _Evaluations, pareto, constraints, points: int, search: dict, runs: List[dict]) -> List[dict]:
@@ -726,6 +754,13 @@ def _trace_front(ev: _Evaluations, pareto, constraints, points: int, search: dic
     ev.aim(m2, s2, constraints)
     more, _ = _search(ev, **{**search, "starts": 1}, first=u_a)
     runs.extend({**r, "question": f"best {m2}"} for r in more)
+    if ev.best is not None:      # the best M2 that is not dominated: the best M1 at (nearly) that M2
+        best2 = s2 * ev.best[0]
+        c = Constraint(m2, ">=" if s2 > 0 else "<=", best2 - s2 * 1e-3 * abs(best2))
+        ev.aim(m1, s1, [*constraints, c])
+        more, _ = _search(ev, **{**search, "starts": 1}, first=ev.u_of(ev.rows[ev.best[1]]["_point"])
+                          if ev.best is not None else None)
+        runs.extend({**r, "question": f"best {m1} at {c.expression}"} for r in more)
     u_b = take(f"best {m2}")
     if u_a is not None and u_b is not None:
         a, b = found[0][m2], found[1][m2]
@@ -839,7 +874,7 @@ def _draw(result: OptimizeResult, files, names, lo, hi, constraints, front, actu
     matplotlib.use("Agg")
     _draw_search(files["figure"], result, names, lo, hi, constraints, actuator)
     if front is not None:
-        _draw_front(files["pareto_figure"], result, front)
+        _draw_front(files["pareto_figure"], result, front, constraints)
     return ""
 
 
@@ -872,43 +907,64 @@ def _draw_search(path, result: OptimizeResult, names, lo, hi, constraints, actua
             ax = axes[i, j]
             y = np.array([_number(m[metric]) for _, m in ok])
             f = np.array(feas, bool)
-            ax.scatter(x[f], y[f], s=14, color="C0", label="feasible evaluation")
-            ax.scatter(x[~f], y[~f], s=14, facecolors="none", edgecolors="C0", label="infeasible evaluation")
+            ax.scatter(x[f], y[f], s=12, color="0.55", label="search: feasible")
+            ax.scatter(x[~f], y[~f], s=12, facecolors="none", edgecolors="0.6", label="search: infeasible")
+            cut = [(p[name], _number(m[metric])) for p, m, e in result.slices.get(name, ()) if not e]
+            if cut:
+                ax.plot(*np.array(cut).T, "-", color="C0", lw=1.6,
+                        label="through the optimum" if len(names) > 1 else "over the range")
             ax.plot([result.optimum[name]], [_number(result.metrics[metric])], "*", color="C3", ms=14,
                     label="optimum")
             for c, info in zip(constraints, result.constraints):
                 if c.metric == metric:
                     ax.axhline(c.bound, ls="--", color="C3" if info["active"] else "0.5",
-                               label=f"{c.expression}" + (" (active)" if info["active"] else ""))
+                               label=_pretty(c) + (" (active)" if info["active"] else ""))
             for side, b in (("lower", lo[j]), ("upper", hi[j])):
                 if abs(result.optimum[name] - b) <= 1e-3 * (hi[j] - lo[j]):
                     ax.axvline(b, color="C2", lw=2, label=f"{side} bound of {name} (active)")
             _axis(ax, "y", _unit(metric, actuator))
             ax.set_ylabel(f"{metric}")
             if i == len(rows) - 1:
+                from matplotlib.ticker import MaxNLocator
                 _axis(ax, "x", _unit(name, actuator))
+                ax.xaxis.set_major_locator(MaxNLocator(5))
                 ax.set_xlabel(name)
             ax.grid(alpha=0.3)
             ax.legend(fontsize=7, loc="best")
     import textwrap
     sense = result.objective["sense"]
-    title = f"mjeap optimize: {sense} {obj}" + (f" subject to {', '.join(c.expression for c in constraints)}"
+    title = f"mjeap optimize: {sense} {obj}" + (f" subject to {', '.join(_pretty(c) for c in constraints)}"
                                                 if constraints else "")
-    fig.suptitle(textwrap.fill(title, 60) + f"\nevery evaluation of the search ({len(result.evaluated)}), SI bounds",
-                 fontsize=9)
+    fig.suptitle(textwrap.fill(title, 90) + f"\nevery evaluation of the search ({len(result.evaluated)})", fontsize=9)
     fig.tight_layout()
     _save(fig, path, "--out (optimize.png)")
 
 
-def _draw_front(path, result: OptimizeResult, pareto) -> None:
-    """pareto.png: every feasible evaluation and the traced front between the two metrics."""
+def _margins(metrics: dict, constraints) -> List[dict]:
+    return [{"met": c.margin(_number(metrics[c.metric])) >= -1e-6} for c in constraints]
+
+
+def _pretty(c: "Constraint") -> str:
+    """A constraint with its bound in engineering notation and its metric's unit."""
+    from matplotlib.ticker import EngFormatter
+    unit = _unit(c.metric, None)
+    bound = EngFormatter(unit=unit.replace("^", "") if unit not in ("-", "") else "", sep="\u00a0")(c.bound)
+    return f"{c.metric} {'>=' if c.sense == '>=' else '<='} {bound}"
+
+
+def _draw_front(path, result: OptimizeResult, pareto, constraints=()) -> None:
+    """pareto.png: every evaluation (hollow where it violates a constraint) and the traced
+    front between the two metrics."""
     import matplotlib.pyplot as plt
     (m1, s1), (m2, s2) = pareto
-    pts = [(m[m1], m[m2]) for _, m, e in result.evaluated if not e]
     fig, ax = plt.subplots(figsize=(6.4, 4.8))
-    if pts:
-        a = np.array([[_number(u), _number(v)] for u, v in pts])
-        ax.scatter(a[:, 1], a[:, 0], s=10, color="0.6", label="evaluations")
+    for feasible in (True, False):
+        a = np.array([[_number(m[m1]), _number(m[m2])] for _, m, e in result.evaluated
+                      if not e and all(c["met"] for c in _margins(m, constraints)) == feasible]).reshape(-1, 2)
+        if feasible:
+            ax.scatter(a[:, 1], a[:, 0], s=10, color="0.55", label="evaluations meeting the constraints")
+        elif a.size:
+            ax.scatter(a[:, 1], a[:, 0], s=10, facecolors="none", edgecolors="0.7", label="evaluations violating one")
     front = [f for f in result.pareto if f["feasible"]]
     ax.plot([f[m2] for f in front], [f[m1] for f in front], "o-", color="C3", label="Pareto front (epsilon-constraint)")
     for k, f in enumerate(front):
@@ -923,7 +979,8 @@ def _draw_front(path, result: OptimizeResult, pareto) -> None:
     ax.set_ylabel(f"{m1} ({'maximised' if s1 > 0 else 'minimised'})")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=8)
-    ax.set_title(f"mjeap optimize --pareto {m1},{m2}: {len(front)} points", fontsize=10)
+    ax.set_title(f"mjeap optimize --pareto {m1},{m2}: {len(front)} points"
+                 + (f"\nsubject to {', '.join(_pretty(c) for c in constraints)}" if constraints else ""), fontsize=10)
     fig.tight_layout()
     _save(fig, path, "--out (pareto.png)")
 
