@@ -140,7 +140,8 @@ def test_a_pareto_front_between_free_deflection_and_blocked_force(tmp_path):
     front = [f for f in r.pareto if f["feasible"]]
     assert len(front) == 4
     t = [f["actuator.roles.piezo.thickness"] for f in front]
-    assert t[0] == pytest.approx(60e-6, rel=1e-6) and t[-1] == pytest.approx(200e-6, rel=1e-6)
+    # the best blocked force is taken at 0.1 % below its maximum, the best deflection there
+    assert t[0] == pytest.approx(60e-6, rel=1e-6) and t[-1] == pytest.approx(200e-6, rel=5e-3)
     assert np.all(np.diff([f["blocked_force"] for f in front]) > 0)
     assert np.all(np.diff([f["free_deflection"] for f in front]) < 0)
     rows = (tmp_path / "o" / "pareto.csv").read_text().splitlines()
