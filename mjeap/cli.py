@@ -207,10 +207,10 @@ def cmd_materials(args) -> int:
     if args.name:
         m = mat.get_material(args.name)
         print(f"{m.name}: {m.title}" + (f"\n  {m.notes}" if m.notes else ""))
-        for k in mat.PROPERTIES:
+        for k in (*mat.PROPERTIES, *(mat.PIEZO_PROPERTIES if m.piezo else ())):
             p = m.property(k)
             rng = f"[{_fmt(p.range[0])}, {_fmt(p.range[1])}]"
-            print(f"  {k:<15} {_fmt(p.value):>9} {p.unit:<7} range {rng}  {p.source}")
+            print(f"  {k:<21} {_fmt(p.value):>9} {p.unit:<7} range {rng}  {p.source}")
         return 0
     keys = ("youngs_modulus", "density", "poisson_ratio")
     rows = [["material", "E (Pa)", "range", "density (kg/m^3)", "range", "nu", "range", "title"]]
@@ -223,16 +223,20 @@ def cmd_materials(args) -> int:
     for r in rows:
         print("  ".join(c.rjust(w) if i in (1, 3, 5) else c.ljust(w) for i, (c, w) in enumerate(zip(r, widths)))
               + "  " + r[-1])
+    piezo = [n for n in names if mat.get_material(n).piezo]
+    if piezo:
+        print(f"\npiezoelectric (d31, permittivity, coercive field, recommended field, tensile strength): "
+              f"{', '.join(piezo)}")
     print("\nsources: mjeap materials NAME (or --json); a layer names one with material = \"NAME\" in an actuator file")
     return 0
 
 
 def material_record(m) -> dict:
     """A material as JSON: title, notes, each property's value, unit, range and source."""
-    from .model.materials import PROPERTIES
+    from .model.materials import PIEZO_PROPERTIES, PROPERTIES
     return {"title": m.title, "notes": m.notes,
             **{k: {"value": m.property(k).value, "unit": m.property(k).unit, "range": list(m.property(k).range),
-                   "source": m.property(k).source} for k in PROPERTIES}}
+                   "source": m.property(k).source} for k in (*PROPERTIES, *(PIEZO_PROPERTIES if m.piezo else ()))}}
 
 
 def _scene_from_args(args, units=None):

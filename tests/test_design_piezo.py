@@ -166,7 +166,7 @@ def test_show_gives_the_unimorphs_first_numbers_from_the_transformed_section(cap
     kappa = E[0] * t[0] * S * (z[0] - zn) / D
     free = kappa * L**2 / 2
     force = 3 * D * w * free / L**3
-    mass = w * L * (7800 * 127e-6 + 8500 * 102e-6)
+    mass = w * L * (7950 * 127e-6 + 8500 * 102e-6)
     assert d["free_deflection"][0] == pytest.approx(free, rel=1e-6) and d["free_deflection"][1] == "m"
     assert d["blocked_force"][0] == pytest.approx(force, rel=1e-6)
     assert d["capacitance"][0] == pytest.approx(EPS0 * 1800 * L * w / 127e-6, rel=1e-9)

@@ -107,10 +107,12 @@ def _m(name, title, E, rho, nu, notes="", piezo=None):
 
 
 #: PZT-5H's datasheet, as Jayaram et al. 2018 used it (its permittivity gives their "about 16 nF")
-_PSI_5H = "Piezo Systems PSI-5H4E data sheet (CTS 3203HD, a PZT-5H, prints the same)"
-_PSI_5A = "Piezo Systems PSI-5A4E data sheet (CTS 3195HD, a PZT-5A, prints the same)"
-_PSI_STRENGTH = ("Piezo Systems material data: ultimate tensile strength 7.6e7 Pa static (2.1e7 Pa dynamic, peak) "
-                 "for its PZT-5A and PZT-5H")
+_PSI_5H = ("Piezo Systems (piezo.com) Piezo Material Properties Data Sheet (2020), PZT-5H (CTS 3203HD prints the same "
+           "K3T, d31 and Ec)")
+_PSI_5A = ("Piezo Systems (piezo.com) Piezo Material Properties Data Sheet (2020), PZT-5A (CTS 3195HD: K3T 1900, "
+           "d31 -190 pm/V, Ec 12 kV/cm)")
+_PSI_STRENGTH = ("Piezo Systems' ceramic material properties: ultimate strength in tension 7.6e7 Pa static (2.1e7 Pa "
+                 "dynamic, peak) for its PZT-5A and PZT-5H")
 _MAX_FIELD_PZT = ("estimate: unipolar drive along the poling of soft PZT bending actuators reaches 1.5-2 V/um "
                   "(the Jayaram et al. 2018 bimorphs: 200 V on 135 um plates, 1.48 V/um); 2 V/um recommended")
 _MSI = "Measurement Specialties, Piezo Film Sensors Technical Manual (1999), typical properties of PVDF film"
@@ -133,7 +135,7 @@ MATERIALS: Dict[str, Material] = {m.name: m for m in (
               "tensile_strength": (76e6, _PSI_STRENGTH, (20e6, 150e6))}),
     _m("pzt-5a", "PZT-5A piezoceramic (small-signal datasheet values)",
        (66e9, f"{_PSI_5A}: Y11E = 6.6e10 Pa", (50e9, 80e9)),
-       (7800.0, f"{_PSI_5A} (7750-7950 kg/m^3)", (7500.0, 8100.0)),
+       (7950.0, f"{_PSI_5A}: 7.95 g/cm^3 (Erturk and Inman 2011: 7750 kg/m^3)", (7500.0, 8100.0)),
        (0.31, f"{_PSI_5A}", (0.25, 0.40)),
        piezo={"d31": (-190e-12, f"{_PSI_5A}: -190 pm/V (Erturk and Inman 2011, appendix E: -171 pm/V)",
                       (-250e-12, -100e-12)),
