@@ -4,7 +4,7 @@
 models: steps per second and real-time factor of every catalog actuator at its default
 discretisation, both representations, unforced (MuJoCo's own stepping loop, one thread).
 
-rollout: seed 000's heaviest experiment (pedot-micro, 12.6 mg at 6.27 mm, standing up,
+rollout: Dadras et al. 2021's heaviest experiment (pedot-micro, 12.6 mg at 6.27 mm, standing up,
 3 Vpp square wave at 0.1 Hz, 20 s) with the drive and the recording on: wall time and
 real-time factor, the drive's own cost per step, and the peak-to-peak tip curvature
 against a run at half the timestep and twice the segments.
@@ -24,13 +24,13 @@ error as its accuracy target.
 sweep: rollouts per second of a 16-point sweep on 1 and 2 local worker processes, and the
 memory of one rollout.
 
-native: seed 000's drive compiled into the model (mjeap.drives.native) against the lockstep loop,
+native: Dadras et al. 2021's drive compiled into the model (mjeap.drives.native) against the lockstep loop,
 side by side: the heaviest experiment as one rollout, a batch of 16 on 2 threads against the
 loop one by one, mj_step of the native model against the bare beam, and the stability
 map's 30 s points per second on 2 workers with either engine.
 
 accuracy: runs at a stated accuracy (mjeap.simulation.accuracy) against the default model, side by
-side: seed 000's heaviest run at 1e-2 and 1e-3 (wall, estimated and true error), a batch of
+side: Dadras et al. 2021's heaviest run at 1e-2 and 1e-3 (wall, estimated and true error), a batch of
 16 at 1e-2 on 2 threads against the loop one by one, the stability map's points at 1e-2,
 where the native step's time goes (MuJoCo's timers) and the accuracy claim on seeded cases.
 
@@ -256,7 +256,7 @@ def _mjeap_cantilever(b, T, P, segments, drive=None, repeats=3, engine="loop"):
 
 
 def _mjeap_at_accuracy(T, P, target, ref, repeats=3):
-    """The same cantilever with seed 000's drive running, mjeap choosing its model for
+    """The same cantilever with Dadras et al. 2021's drive running, mjeap choosing its model for
     ``target`` (mjeap.simulation.accuracy, its quantity sampled at the end only: the settled tip arc's
     curvature against a converged model, relative to its change). The chosen model is then
     built once (as the rod is) and its run timed as the others; its tip is checked against
@@ -371,7 +371,7 @@ def bench_elastica(T=0.05, elements=20, with_pyelastica=True):
                                          for d in ("blocking-force", "rc-relaxation")],
            "mjeap_with_native_drive": err(_mjeap_cantilever(b, T, P, 20, drive="rc-relaxation", engine="native"))}
     out["mjeap_with_drive_callback"][0]["drive"] = "blocking-force at 0 V (no moment): the callback's cost alone"
-    out["mjeap_with_drive_callback"][1]["drive"] = ("rc-relaxation at 0 V: seed 000's drive; its back-relaxation "
+    out["mjeap_with_drive_callback"][1]["drive"] = ("rc-relaxation at 0 V: Dadras et al. 2021's drive; its back-relaxation "
                                                     "creeps the beam, so the tip is not the elastic one")
     out["mjeap_with_native_drive"]["drive"] = ("rc-relaxation compiled into the model (mjeap.drives.native, Maxwell arms), "
                                                "on mujoco.rollout")
@@ -504,7 +504,7 @@ def _step_phases(model, data, n=20000) -> dict:
 
 def bench_accuracy(claim_cases=12):
     """Runs at a stated accuracy (mjeap.simulation.accuracy) against today's default model, side by side:
-    seed 000's heaviest run (wall of all runs, estimated and true error against 40 segments
+    Dadras et al. 2021's heaviest run (wall of all runs, estimated and true error against 40 segments
     at 1/60 of the 10 ms sample grid under discrete), a batch of 16 at 1e-2 on 2 threads
     against the loop one by one, the stability map's points at 1e-2, where the native
     step's time goes, and the accuracy claim on seeded cases."""
@@ -726,7 +726,7 @@ def bench_optimize(f_min=800.0, box=(5e-3, 15e-3), resolution=0.01):
 
 def bench_warp(map_points=4, duration=1.0, batch=16, batch_duration=0.6):
     """The warp engine against the native one on this machine (Warp's CPU device unless a GPU
-    is found; the device is in the output): a batch of seed 000's standing run with 16
+    is found; the device is in the output): a batch of Dadras et al. 2021's standing run with 16
     amplitudes, and a small stability map (``map_points`` points of ``duration`` s, serial)."""
     import tempfile
     from mjeap import Payload, rollout_batch

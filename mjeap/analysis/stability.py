@@ -1,11 +1,11 @@
-"""Stability of seed 000's inverted actuator under a payload: the theory boundaries of a
+"""Stability of Dadras et al. 2021's inverted actuator under a payload: the theory boundaries of a
 payload x amplitude map and the simulated edge read off a sweep.
 
 The beam stands up (clamp below), the payload sits at l_e past the clamp on a rigid arm
 beyond the beam's end (L = 6 mm, l_e = 6.27 mm). Theory is amplitude independent: the
 Euler column with the payload on the arm (k a tan(kL) = 1, :func:`analytical.critical_load_with_arm`)
 with the instantaneous EI of eq. 8 and with its relaxed (DC) EI, x pole/zero = 0.3/0.52,
-and the paper's own Region 3 model's marginal mass. Seed 000's criterion for a point:
+and the paper's own Region 3 model's marginal mass. Dadras et al. 2021's criterion for a point:
 the tip curvature still changes sign in the third period of the square wave.
 
 The map itself (its sweep, report, figure and recording) is :mod:`mjeap.stability_map`.
@@ -18,7 +18,7 @@ import numpy as np
 
 from ..model import analytical as an
 
-#: the sweep base of seed 000's map: standing up, payload at l_e, 0.1 Hz square wave, 30 s
+#: the sweep base of Dadras et al. 2021's map: standing up, payload at l_e, 0.1 Hz square wave, 30 s
 #: (three periods)
 MAP_BASE = dict(actuator="pedot-micro", orientation="up", payload_position=6.27e-3, waveform="square",
                 frequency=0.1, duration=30.0)

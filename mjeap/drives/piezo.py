@@ -1,4 +1,4 @@
-"""PZT-5H bending bimorph under unipolar simultaneous drive (Jayaram 2018, seed 003).
+"""PZT-5H bending bimorph under unipolar simultaneous drive (Jayaram 2018, Jayaram et al. 2018).
 
 A constant bias V_bias sits across the outer electrodes and the drive signal V_sig in
 [0, V_bias] on the centre layer, so the two plates see V_bias - V_sig and V_sig, and the
@@ -15,7 +15,7 @@ Moment per volt, derived three ways (they agree; the factor was 1/2 before issue
    Harvard's HAMR actuator model (PZTBender2.m) writes the same as forces Ft - Fb that are
    proportional to the plates' voltage difference V = 2 V_sig - V_bias, which is the V of
    the closed forms in ``mjeap.model.analytical`` (V_bias at full drive).
-2. Seed 003 eq. (13): I_mech = 2 A f31 d(eps_1)/dt, eps_1 the bending strain of one plate,
+2. Jayaram et al. 2018 eq. (13): I_mech = 2 A f31 d(eps_1)/dt, eps_1 the bending strain of one plate,
    kappa (t_p + t_cf) / 2 at its mid-plane. Over a hinge j of width w_j and rotation theta_j
    (A eps_1 summed as w_j l_j kappa_j (t_p + t_cf)/2 = w_j theta_j (t_p + t_cf) / 2):
    I_mech = sum_j Gamma_j dtheta_j/dt with Gamma_j = f31 w_j (t_p + t_cf).
@@ -69,13 +69,13 @@ from ..model import analytical as an
 from .base import Drive, NativeForm, OpenLoop, register_drive
 
 _J = "Jafferis et al. 2015: f31 ~ 32 Pa m/V free (24 blocked)"
-_C = ("estimate: seed 003 measures about half the 16 nF datasheet value for a fixed HAMR actuator; "
+_C = ("estimate: Jayaram et al. 2018 measures about half the 16 nF datasheet value for a fixed HAMR actuator; "
       "8 nF scaled with the PZT area (Table 1)")
 _R = "illustrative: the extracted fits of eq. 4a are unreliable (actuator reference); refit before use"
 
 
 def _params(area_mm2: float):
-    return {"bias": (200.0, "V", "seed 003: 25-200 V tested"),
+    return {"bias": (200.0, "V", "Jayaram et al. 2018: 25-200 V tested"),
             "f31": (32.0, "Pa m/V", _J),
             "capacitance": (8e-9 * area_mm2 / 32.2, "F", _C),
             "resistance": (1e9, "ohm", _R)}

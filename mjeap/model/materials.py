@@ -88,10 +88,10 @@ class Material:
         return getattr(self, key)
 
 
-_SEED_000 = "Dadras et al. 2021 (seed 000)"
-_SEED_001 = "Mutlu, Alici, Li 2013 (seed 001)"
-_SEED_002 = "Metello 2020, MSc thesis (seed 002)"
-_SEED_003 = "Jayaram et al. 2018 (seed 003)"
+_SEED_000 = "Dadras et al. 2021"
+_SEED_001 = "Mutlu, Alici, Li 2013"
+_SEED_002 = "Metello 2020, MSc thesis"
+_SEED_003 = "Jayaram et al. 2018"
 _HAMR = "Jafferis et al. 2015, as used by Harvard's HAMR actuator model (PZTBender2.m)"
 _NU_POLY = Property(0.35, "-", "literature default for polymers", (0.25, 0.499))
 
@@ -177,7 +177,7 @@ MATERIALS: Dict[str, Material] = {m.name: m for m in (
        _NU_POLY, "an effective layer: the source gives the whole stack only"),
     _m("polypyrrole", "polypyrrole (PPy), TFSI doped, electrolyte-soaked",
        (80e6, "literature default: E_PPy ~ 80 MPa (Sens. Actuators A 163 (2010) 240)", (10e6, 3e9)),
-       (1400.0, "estimate: soaked density ~ 1.4 g/cm^3 (not in seed 001)", (1000.0, 1700.0)),
+       (1400.0, "estimate: soaked density ~ 1.4 g/cm^3 (not in Mutlu et al. 2013)", (1000.0, 1700.0)),
        (0.3, "literature default (0.3)", (0.2, 0.45))),
     _m("pvdf-membrane", "porous PVDF membrane with LiTFSI/PC (PPy trilayer core)",
        (440e6, "literature default: E_PVDF membrane ~ 440 MPa (Alici's papers, unverified)", (50e6, 3e9)),
@@ -187,7 +187,7 @@ MATERIALS: Dict[str, Material] = {m.name: m for m in (
        (99.5e6, f"{_SEED_002}, Table 3.4 (9.95e7 Pa)", (30e6, 1e9)),
        (1780.0, f"{_SEED_002}, Table 5.2 (1.78 g/cm^3; Table 3.4 prints 1.7)", (1600.0, 1950.0)),
        (0.33, f"{_SEED_002}, Table 3.4", (0.25, 0.45))),
-    _m("aluminium-foil", "aluminium foil electrode, as bonded in seed 002's unimorphs (effective)",
+    _m("aluminium-foil", "aluminium foil electrode, as bonded in Metello 2020's unimorphs (effective)",
        (1.82e9, f"{_SEED_002}, Table 3.4 (1.82e9 Pa: the bonded foil's effective modulus; bulk aluminium is "
                 "69 GPa)", (0.5e9, 75e9)),
        (2700.0, f"{_SEED_002}, Table 3.4", (2600.0, 2800.0)),
@@ -196,7 +196,7 @@ MATERIALS: Dict[str, Material] = {m.name: m for m in (
        (69e9, "handbook value (68-71 GPa)", (60e9, 75e9)),
        (2700.0, "handbook value", (2600.0, 2800.0)),
        (0.33, "handbook value", (0.3, 0.36))),
-    _m("kapton-tape", "Kapton polyimide tape, as in seed 002's unimorphs",
+    _m("kapton-tape", "Kapton polyimide tape, as in Metello 2020's unimorphs",
        (8.46e8, f"{_SEED_002}, Table 3.4 (8.46e8 Pa, the tape with its adhesive)", (0.3e9, 4e9)),
        (1420.0, f"{_SEED_002}, Table 3.4", (1300.0, 1500.0)),
        (0.34, f"{_SEED_002}, Table 3.4", (0.3, 0.4))),

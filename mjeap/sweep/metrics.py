@@ -43,7 +43,7 @@ def metric_peak_to_peak(r, point, scene) -> float:
 
 
 def metric_returns(r, point, scene) -> bool:
-    """Seed 000's stability criterion: the tip curvature still changes sign in the last
+    """Dadras et al. 2021's stability criterion: the tip curvature still changes sign in the last
     drive period (the actuator follows the drive instead of staying collapsed); at a target on
     it, decided on the margin the accuracy report gives."""
     return reported_value(r, "returns", _period(point)) > 0
