@@ -735,10 +735,30 @@ def build_parser() -> argparse.ArgumentParser:
     return ap
 
 
+def _told(func):
+    """Run ``func`` with a material's range warnings (a layer's value, a field past its
+    limit: :class:`mjeap.model.materials.RangeWarning`) told as one line each,
+    ``mjeap: warning: ...``, once per text; other warnings as Python tells them."""
+    import warnings
+    from .model.materials import RangeWarning
+    told, plain = set(), warnings.showwarning
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        if not issubclass(category, RangeWarning):
+            return plain(message, category, filename, lineno, file, line)
+        if str(message) not in told:
+            told.add(str(message))
+            print(f"mjeap: warning: {message}", file=sys.stderr)
+
+    with warnings.catch_warnings():
+        warnings.showwarning = show
+        return func()
+
+
 def main(argv: Optional[List[str]] = None) -> int:
     def command() -> int:
         args = build_parser().parse_args(argv)
-        return args.func(args)
+        return _told(lambda: args.func(args))
     return run_command(command)
 
 

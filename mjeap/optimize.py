@@ -547,6 +547,7 @@ def optimize(actuator, vary: Mapping[str, object], maximize: Optional[str] = Non
         check_metric_settings(corners, fixed, wanted)
         for c in corners:                       # the box's corners build (a stack the drive takes)
             design.design_actuator(base_name, c)
+        _check_fields(base_name, fixed, corners, constraints)
         columns = ["point_id", *names, *wanted, "error", "wall_s", "settings"]
         # ---- the run
         from threadpoolctl import threadpool_limits
@@ -822,6 +823,36 @@ def _sensitivities(ev: _Evaluations, row: dict, constraints, active: float, fd_s
     for o in out:
         o["kkt_residual"] = residual
     return out
+
+
+def _check_fields(actuator, fixed: dict, corners: List[dict], constraints) -> None:
+    """One warning (:class:`mjeap.model.laminate.FieldWarning`) where a corner of the box
+    drives a piezo layer past its material's limits and no constraint on ``max_field`` bounds
+    the answer (the points' own drives are quiet: a study's field is its metric)."""
+    import warnings
+    from .design import design_actuator
+    from .drives import make_drive
+    from .drives.piezo import LinearPiezo
+    from .model.laminate import FieldWarning
+    from .simulation.scene import Scene
+    if any(c.metric in ("max_field", "max_reverse_field") for c in constraints):
+        return
+    texts = []
+    for c in corners:
+        try:
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore")
+                act = design_actuator(actuator, {**fixed, **c})
+                drv = make_drive(None, Scene(act, segments=2),
+                                 **{k[6:]: v for k, v in {**fixed, **c}.items() if k.startswith("drive.")})
+        except MjeapError:
+            return                                 # the points report it
+        if not isinstance(drv, LinearPiezo):
+            return
+        texts += drv.laminate().field_warnings(drv.voltage_range())
+    if texts:
+        warnings.warn(f"the box reaches fields past a layer's limit ({texts[0]}); a constraint such as "
+                      "--subject-to max_field<=2V/um keeps the optimum within it", FieldWarning, stacklevel=3)
 
 
 def _parse_pareto(pareto) -> Tuple[Tuple[str, float], Tuple[str, float]]:

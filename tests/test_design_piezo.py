@@ -113,10 +113,9 @@ def test_a_field_limited_optimum_is_the_thinnest_plate_the_limit_allows(tmp_path
 
     ts = np.linspace(60e-6, 200e-6, 8)
     assert np.all(np.diff([closed(t) for t in ts]) < 0), "the free deflection falls with t_p: the limit binds"
-    with pytest.warns(UserWarning):
-        r = mjeap.optimize(HAMR, {"actuator.roles.piezo.thickness": ("60um", "200um")}, maximize="free_deflection",
-                           subject_to=["max_field<=2V/um"], voltage=f"step:{V}V", duration=0.02,
-                           base={"segments": 10}, starts=1, out=tmp_path / "o", progress=False)
+    r = mjeap.optimize(HAMR, {"actuator.roles.piezo.thickness": ("60um", "200um")}, maximize="free_deflection",
+                       subject_to=["max_field<=2V/um"], voltage=f"step:{V}V", duration=0.02,
+                       base={"segments": 10}, starts=1, out=tmp_path / "o", progress=False)
     assert r.success and r.optimum["actuator.roles.piezo.thickness"] == pytest.approx(t_star, rel=1e-2)
     [c] = r.constraints
     assert c["active"] and c["value"] == pytest.approx(e_max, rel=1e-3)
@@ -126,6 +125,19 @@ def test_a_field_limited_optimum_is_the_thinnest_plate_the_limit_allows(tmp_path
     assert s["kind"] == "constraint" and s["sensitivity"] == pytest.approx(-V / e_max**2 * slope, rel=0.05)
     files = json.loads((tmp_path / "o" / "result.json").read_text())["files"]
     assert Path(files["figure"]).stat().st_size > 10_000
+
+
+def test_a_box_past_the_field_limit_without_a_field_constraint_is_warned_once(monkeypatch, recwarn):
+    """Issue 42: asked for the most stroke, the optimiser thins the plates past PZT-5H's
+    field; the box's corners say so once, before any work, naming the layer and field."""
+    from mjeap.model.laminate import FieldWarning
+    _no_work(monkeypatch)
+    with pytest.raises(pytest.fail.Exception):          # the first evaluation: the check came before it
+        mjeap.optimize("pzt-hamr-small", {"actuator.roles.piezo.thickness": ("60um", "150um")},
+                       maximize="free_deflection", voltage="step:200V", duration=0.02, progress=False)
+    told = [w for w in recwarn if issubclass(w.category, FieldWarning)]
+    assert len(told) == 1 and "layer pzt-bottom sees 3.33 V/um" in str(told[0].message)
+    assert "max_field" in str(told[0].message)
 
 
 @pytest.mark.slow

@@ -36,7 +36,7 @@ import pytest
 
 from mjeap import Scene, rollout, sweep
 from mjeap.drives import make_drive
-from mjeap.drives.piezo_laminate import FieldWarning
+from mjeap.model.laminate import FieldWarning
 from mjeap.errors import ParameterError
 from mjeap.model.actuator_file import read_actuator
 from mjeap.model.catalog import CATALOG
@@ -340,6 +340,17 @@ def test_a_voltage_range_past_the_recommended_field_is_warned_naming_layer_and_f
     p.write_text(text)
     with pytest.warns(FieldWarning, match=r"layer pzt sees 2.36 V/um .* past its recommended 2 V/um"):
         make_drive(None, Scene(str(p)))
+
+
+def test_a_piezo_bimorph_thinned_past_the_field_limit_is_warned_too():
+    """Issue 42's optimum: pzt-hamr-small's plates thinned to 75 um at 200 V, 2.7 V/um."""
+    from mjeap import design
+    act = design.design_actuator("pzt-hamr-small", {"actuator.roles.piezo.thickness": 75e-6})
+    with pytest.warns(FieldWarning, match=r"layer pzt-bottom sees 2.67 V/um .* past its recommended 2 V/um"):
+        make_drive(None, Scene(act))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        make_drive(None, Scene("pzt-hamr-small"))          # 1.48 V/um: no warning
 
 
 def test_the_physical_sets_f1_gap_the_docs_state():

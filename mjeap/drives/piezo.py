@@ -206,6 +206,15 @@ class LinearPiezo(OpenLoop, NativeForm, Drive):
         sees and the dielectric (blocked) term of the current."""
         raise NotImplementedError
 
+    def warn_fields(self) -> None:
+        """Warn (:class:`mjeap.model.laminate.FieldWarning`) of each layer the voltage range
+        drives past its material's recommended field or coercive field, naming the layer."""
+        import warnings
+        from ..model.laminate import FieldWarning
+        act = self.scene.actuator
+        for text in self.laminate().field_warnings(self.voltage_range()):
+            warnings.warn(f"{act.source_file or act.id}: {text}", FieldWarning, stacklevel=3)
+
 
 @register_drive
 class PiezoBimorphDrive(LinearPiezo):
@@ -228,6 +237,7 @@ class PiezoBimorphDrive(LinearPiezo):
         # is f31 / (1 - nu) (mjeap.model.laminate)
         self._couple(self._f31() * w * (self.t_p + self.t_cf), 0.5 * float(self.params["bias"]),
                      capacitance=self.params["capacitance"])
+        self.warn_fields()
 
     def _plane_strain_factor(self) -> float:
         """1, or 1 / (1 - nu_p) where the section is in plane strain (mjeap.model.laminate)."""

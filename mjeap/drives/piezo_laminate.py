@@ -21,46 +21,20 @@ A file refused before any work names the key: no piezo layer, a piezo layer with
 permittivity (and no material to supply them), a complement layer without a bias, a
 coupling d31^2 Y >= eps33^T. A layer driven past its material's recommended field over the
 file's voltage range (or against its poling past the coercive field) is warned about, naming
-the layer and the field (:class:`FieldWarning`).
+the layer and the field (:class:`~mjeap.model.laminate.FieldWarning`, as ``piezo-bimorph``).
 """
 from __future__ import annotations
 
-import warnings
 from typing import Dict, Optional
 
 import numpy as np
 
 from ..errors import ParameterError
-from ..model.laminate import Laminate, laminate_reason, piezo_layers
-from ..model.materials import RangeWarning
+from ..model.laminate import FieldWarning, Laminate, laminate_reason, piezo_layers
 from .base import register_drive
 from .piezo import LinearPiezo
 
-__all__ = ["PiezoLaminateDrive", "FieldWarning", "field_warnings"]
-
-
-class FieldWarning(RangeWarning):
-    """A piezo layer is driven past its material's recommended field, or against its poling
-    past its coercive field, somewhere in the voltage range."""
-
-
-def field_warnings(lam: Laminate, v_range) -> list:
-    """The texts of the fields past a layer's limits over the voltages ``v_range`` (V): along
-    the poling beyond the material's recommended maximum field, against it beyond the
-    coercive field (where the material gives them)."""
-    out = []
-    f = lam.fields_along_poling(np.asarray(v_range, float))
-    for j, p in enumerate(lam.piezo):
-        top, rev = float(np.abs(f[j]).max()), float(np.maximum(-f[j], 0.0).max())
-        lim = p.limit("max_field")
-        if lim is not None and top > lim[0] * (1 + 1e-9):
-            out.append(f"layer {p.name} sees {top / 1e6:.3g} V/um over the voltage range "
-                       f"[{v_range[0]:g}, {v_range[-1]:g}] V, past its recommended {lim[0] / 1e6:.3g} V/um ({lim[1]})")
-        ec = p.limit("coercive_field")
-        if ec is not None and rev > ec[0] * (1 + 1e-9):
-            out.append(f"layer {p.name} sees {rev / 1e6:.3g} V/um against its poling over the voltage range, past its "
-                       f"coercive field {ec[0] / 1e6:.3g} V/um: it depolarises ({ec[1]})")
-    return out
+__all__ = ["PiezoLaminateDrive", "FieldWarning"]
 
 
 _DERIVED = "derived: the clamped capacitance of the piezo layers (mjeap.model.laminate)"
@@ -108,8 +82,7 @@ class PiezoLaminateDrive(LinearPiezo):
         else:
             g = self.lam.electrode_areas() / np.array([act.layers[p.index].thickness for p in self.lam.piezo])
             self._leak = np.array([p.sign for p in self.lam.piezo]) * g / (float(r) * g.sum())
-        for text in field_warnings(self.lam, self.voltage_range()):
-            warnings.warn(f"{act.source_file or act.id}: {text}", FieldWarning, stacklevel=2)
+        self.warn_fields()
 
     def _rest(self, gamma, m0):
         """(whether the rest voltage -M0_j / Gamma_j is the same at every hinge, that voltage

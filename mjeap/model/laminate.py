@@ -53,7 +53,12 @@ import numpy as np
 
 from . import materials as mat
 
-__all__ = ["EPS0", "PiezoLayer", "piezo_layers", "laminate_reason", "Laminate"]
+__all__ = ["EPS0", "PiezoLayer", "piezo_layers", "laminate_reason", "Laminate", "FieldWarning"]
+
+class FieldWarning(mat.RangeWarning):
+    """A piezo layer is driven past its material's recommended field, or against its poling
+    past its coercive field, somewhere in the voltage range (:meth:`Laminate.field_warnings`)."""
+
 
 #: vacuum permittivity (F/m), CODATA 2018
 EPS0 = 8.8541878128e-12
@@ -230,6 +235,26 @@ class Laminate:
         f = np.maximum(-self.fields_along_poling(v), 0.0).max(axis=1)
         j = int(np.argmax(f))
         return float(f[j]), self.piezo[j].name
+
+    def field_warnings(self, v_range) -> List[str]:
+        """The fields past a layer's limits over the voltages ``v_range`` (V), as texts naming
+        the layer and the field: along the poling beyond its material's recommended maximum
+        field, against it beyond the coercive field (where the material gives them)."""
+        out = []
+        v_range = np.asarray(v_range, float)
+        f = self.fields_along_poling(v_range)
+        where = f"over the voltage range [{v_range.min():g}, {v_range.max():g}] V"
+        for j, p in enumerate(self.piezo):
+            top, rev = float(np.abs(f[j]).max()), float(np.maximum(-f[j], 0.0).max())
+            lim = p.limit("max_field")
+            if lim is not None and top > lim[0] * (1 + 1e-9):
+                out.append(f"layer {p.name} sees {top / 1e6:.3g} V/um {where}, past its recommended "
+                           f"{lim[0] / 1e6:.3g} V/um ({lim[1]})")
+            ec = p.limit("coercive_field")
+            if ec is not None and rev > ec[0] * (1 + 1e-9):
+                out.append(f"layer {p.name} sees {rev / 1e6:.3g} V/um against its poling {where}, past its "
+                           f"coercive field {ec[0] / 1e6:.3g} V/um: it depolarises ({ec[1]})")
+        return out
 
     def stress_coefficients(self, x: float) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(d sigma / d kappa, d sigma / dV, sigma at kappa = V = 0), each (layers, 2): the axial
