@@ -328,7 +328,7 @@ def design_numbers(actuator, *, segments: Optional[int] = None) -> Dict[str, obj
     if piezo and p.residual_tip_mass == 0:
         how += "; " + F1_NOTE
     out["first_frequency"] = (float(scene.choice.first_frequency), "Hz", how)
-    mass = float(act.total_mass() + p.tip_block_mass)
+    mass = float(act.actuator_mass())
     out["mass"] = (mass, "kg", MASS_NOTE)
     if not piezo:
         none = why or f"n/a: the {drv.name} drive has no laminate closed form"

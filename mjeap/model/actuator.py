@@ -159,6 +159,11 @@ class Actuator:
         """Mass of the free length (kg), without the tip extension."""
         return self.mass.value if self.mass is not None else self._layered_mass()
 
+    def actuator_mass(self) -> float:
+        """The actuator's mass (kg): its free length and its rigid tip block (extension and
+        residual mass). The one mass mjeap reports (the ``mass`` metric, ``mjeap show``)."""
+        return self.total_mass() + self.planform.tip_block_mass
+
 
 def validate_actuator(act: Actuator) -> Actuator:
     """Raise ParameterError naming the first non-positive size or property of ``act``."""

@@ -107,7 +107,7 @@ def metric_mass(r, point, scene) -> float:
     """Mass (kg) of the beam (its free length) and its rigid tip block, without a payload;
     no rollout."""
     act = scene.actuator
-    return float(act.total_mass() + act.planform.tip_block_mass)
+    return float(act.actuator_mass())
 
 
 def _end_tip(r, scene):
