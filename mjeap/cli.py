@@ -69,14 +69,27 @@ def drive_rows(a) -> dict:
     return {"name": name, "model": cls.model_used, "parameters": rows}
 
 
+#: the designer's first numbers `mjeap show` prints (and --json keys), in this order
+DESIGN_KEYS = ("first_frequency", "free_deflection", "blocked_force", "capacitance", "blocked_capacitance",
+               "energy_density", "mass")
+#: which capacitance a datasheet gives, and what Jayaram et al. 2018 measured (section 3)
+CAPACITANCE_NOTE = ("a datasheet's permittivity eps33^T (constant stress) gives the free capacitance; Jayaram et al. "
+                    "2018 measured the fixed (blocked) capacitance of Type II at less than half the 16 nF that value "
+                    "gives (section 3)")
+
+
 def describe(name: str) -> dict:
     """Every parameter of an actuator (catalog id or file) with unit and provenance, its
-    drive's parameters with theirs, plus derived values."""
+    drive's parameters with theirs, derived values and the designer's first numbers
+    (:data:`DESIGN_KEYS`, :func:`mjeap.studies.design_numbers.design_numbers`)."""
+    from .studies.design_numbers import design_numbers
     from .model import analytical
+    from .model.laminate import piezo_layers
     from .simulation.scene import Scene
     a = _actuator(name)
+    piezo = {p.index: p for p in piezo_layers(a)}
     layers = []
-    for l in a.layers:
+    for i, l in enumerate(a.layers):
         layers.append({
             "name": l.name, "material": l.material,
             "thickness": (l.thickness, "m", l.provenance("thickness")),
@@ -85,6 +98,14 @@ def describe(name: str) -> dict:
             "poisson_ratio": (l.poisson_ratio, "-", l.provenance("poisson_ratio")),
             "density": (l.density, "kg/m^3", l.provenance("density")),
         })
+        pz = piezo.get(i)
+        if pz is not None and a.drive == "piezo":
+            layers[-1].update({
+                "d31": (pz.d31, "m/V", pz.sources.get("d31", "none given")),
+                "relative_permittivity": (pz.relative_permittivity, "-", pz.sources.get("relative_permittivity",
+                                                                                         "none given")),
+                "electrode": (pz.electrode, "-", "signal: V; complement: bias - V"),
+                "poling": (pz.poling, "-", "the sign of the free strain d31 V / t")})
     p = a.planform
     sec = a.section_at(0.0)
     EI0 = float(a.flexural_rigidity_at(0.0)[0])
@@ -93,7 +114,9 @@ def describe(name: str) -> dict:
     f1_formula = float(analytical.natural_frequencies(a.length, EI0, mu, n=1)[0]) if uniform else None
     scene = Scene(a)
     c = scene.choice
+    numbers = design_numbers(a)
     return {
+        **{k: numbers[k] for k in DESIGN_KEYS}, "warnings": numbers["warnings"],
         "id": a.id, "title": a.title, "document": a.document, "file": _actuator_file_of(a), "layers": layers,
         "planform": {"length": (p.length, "m", p.source), "base_width": (p.base_width, "m", p.source),
                      "tip_width": (p.tip_width, "m", p.source),
@@ -111,7 +134,8 @@ def describe(name: str) -> dict:
             "flexural_rigidity_tip": (float(a.flexural_rigidity_at(a.length)[0]), "N m^2", ""),
             "neutral_axis": (sec.neutral_axis, "m from the bottom face", "multilayer_section"),
             "thickness": (a.thickness, "m", ""),
-            "mass": (a.total_mass(), "kg", "measured" if a.mass else "layers x planform"),
+            "mass": (numbers["mass"][0], "kg", ("measured beam" if a.mass else "layers x planform")
+                     + " and the rigid tip block (as the mass metric and mass above)"),
             "first_frequency_uniform_beam": (f1_formula, "Hz", "Euler-Bernoulli" if uniform else "tapered: n/a"),
             "first_frequency_model": (c.first_frequency, "Hz", f"MuJoCo hinge chain, {scene.layout.segments} segments"),
             "highest_frequency_model": (c.highest_frequency, "Hz", "highest discrete mode"),
@@ -126,12 +150,18 @@ def cmd_show(args) -> int:
     if args.json:
         print(json.dumps(d, indent=2, default=str))
         return 0
+    for w in d["warnings"]:
+        print(f"mjeap: warning: {w}", file=sys.stderr)
     print(f"{d['id']}: {d['title']}\n  source: {d['document']}\n  file: {d['file']}\n\nlayers (bottom to top):")
     for l in d["layers"]:
         print(f"  {l['name']} ({l['material']})")
-        for k in ("thickness", "width", "youngs_modulus", "poisson_ratio", "density"):
+        for k in ("thickness", "width", "youngs_modulus", "poisson_ratio", "density", "d31",
+                  "relative_permittivity", "electrode", "poling"):
+            if k not in l:
+                continue
             v, u, s = l[k]
-            print(f"    {k:<16} {v if isinstance(v, str) else _fmt(v):>12} {u:<7} {s}")
+            v = "-" if v is None else v
+            print(f"    {k:<21} {v if isinstance(v, str) else _fmt(v):>12} {u:<7} {s}")
 
     def block(title, items):
         print(f"\n{title}:")
@@ -139,6 +169,9 @@ def cmd_show(args) -> int:
             vs = "-" if v is None else (_fmt(v) if isinstance(v, float) else str(v))
             print(f"  {k:<30} {vs:>12} {u:<8} {s}")
 
+    block("at the voltage range (closed forms, no rollout)", {k: d[k] for k in DESIGN_KEYS})
+    if d["capacitance"][0] is not None:
+        print(f"  ({CAPACITANCE_NOTE})")
     block("planform", d["planform"])
     if d["overrides"]:
         block("identified values (override the layers)", d["overrides"])
@@ -174,10 +207,10 @@ def cmd_materials(args) -> int:
     if args.name:
         m = mat.get_material(args.name)
         print(f"{m.name}: {m.title}" + (f"\n  {m.notes}" if m.notes else ""))
-        for k in mat.PROPERTIES:
+        for k in (*mat.PROPERTIES, *(mat.PIEZO_PROPERTIES if m.piezo else ())):
             p = m.property(k)
             rng = f"[{_fmt(p.range[0])}, {_fmt(p.range[1])}]"
-            print(f"  {k:<15} {_fmt(p.value):>9} {p.unit:<7} range {rng}  {p.source}")
+            print(f"  {k:<21} {_fmt(p.value):>9} {p.unit:<7} range {rng}  {p.source}")
         return 0
     keys = ("youngs_modulus", "density", "poisson_ratio")
     rows = [["material", "E (Pa)", "range", "density (kg/m^3)", "range", "nu", "range", "title"]]
@@ -190,16 +223,20 @@ def cmd_materials(args) -> int:
     for r in rows:
         print("  ".join(c.rjust(w) if i in (1, 3, 5) else c.ljust(w) for i, (c, w) in enumerate(zip(r, widths)))
               + "  " + r[-1])
+    piezo = [n for n in names if mat.get_material(n).piezo]
+    if piezo:
+        print(f"\npiezoelectric (d31, permittivity, coercive field, recommended field, tensile strength): "
+              f"{', '.join(piezo)}")
     print("\nsources: mjeap materials NAME (or --json); a layer names one with material = \"NAME\" in an actuator file")
     return 0
 
 
 def material_record(m) -> dict:
     """A material as JSON: title, notes, each property's value, unit, range and source."""
-    from .model.materials import PROPERTIES
+    from .model.materials import PIEZO_PROPERTIES, PROPERTIES
     return {"title": m.title, "notes": m.notes,
             **{k: {"value": m.property(k).value, "unit": m.property(k).unit, "range": list(m.property(k).range),
-                   "source": m.property(k).source} for k in PROPERTIES}}
+                   "source": m.property(k).source} for k in (*PROPERTIES, *(PIEZO_PROPERTIES if m.piezo else ()))}}
 
 
 def _scene_from_args(args, units=None):
@@ -508,7 +545,7 @@ def cmd_optimize(args) -> int:
                  voltage=args.voltage, duration=args.duration, base=base,
                  metrics=[m for m in (args.metrics or "").split(",") if m], method=args.method, starts=args.starts,
                  seed=args.seed, max_evaluations=args.max_evaluations, out=args.out,
-                 progress=False if args.quiet else None)
+                 progress=False if args.quiet else None, pareto=args.pareto, pareto_points=args.pareto_points)
     print(json.dumps(r.as_dict(), indent=2, default=float))
     if not r.success:
         print(f"mjeap optimize: {r.message}", file=sys.stderr)
@@ -626,8 +663,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0, help="seed of the random design")
     p.add_argument("--metrics", default="peak_to_peak,returns",
                    help="comma list: peak_to_peak, returns, settling_time, max_stress_proxy, max_tip_deflection, "
-                        "first_frequency, mass, free_deflection, blocked_force, energy_density, peak_power, "
-                        "energy_per_cycle")
+                        "first_frequency, mass, free_deflection, blocked_force, energy_density (a step's), stroke (a "
+                        "periodic drive's), peak_power, energy_per_cycle, max_field, max_reverse_field, max_stress, "
+                        "capacitance (piezo drives)")
     p.add_argument("--out", default="out/sweep.csv", help="results CSV (appended; finished points are skipped)")
     from .studies.sweep import EXECUTORS
     p.add_argument("--executor", choices=EXECUTORS, default="processes")
@@ -644,10 +682,14 @@ def build_parser() -> argparse.ArgumentParser:
                         "actuator.roles.piezo.thickness=100um:150um, drive.bias=100:200, payload_mass=0:5mg (repeatable)")
     goal = p.add_mutually_exclusive_group(required=True)
     goal.add_argument("--maximize", metavar="METRIC", help="the metric to maximise (free_deflection, blocked_force, "
-                      "energy_density, first_frequency, ...)")
-    goal.add_argument("--minimize", metavar="METRIC", help="the metric to minimise (mass, peak_power, ...)")
+                      "energy_density, stroke, first_frequency, ...)")
+    goal.add_argument("--minimize", metavar="METRIC", help="the metric to minimise (mass, peak_power, max_field, ...)")
+    goal.add_argument("--pareto", metavar="M1,M2", help="trace the front between two metrics (each maximised; "
+                      "min:NAME minimises), e.g. free_deflection,blocked_force: pareto.csv and pareto.png")
+    p.add_argument("--pareto-points", type=int, default=7, help="points of the front (default 7)")
     p.add_argument("--subject-to", action="append", metavar="EXPR",
-                   help='a constraint "METRIC>=VALUE" or "METRIC<=VALUE" (SI or with a unit; repeatable)')
+                   help='a constraint "METRIC>=VALUE" or "METRIC<=VALUE", SI or with the metric\'s unit: '
+                        '"first_frequency>=800Hz", "max_field<=1V/um" (repeatable)')
     p.add_argument("--voltage", help="waveform of the rollouts the metrics need: step:200V, sine:50V@100Hz,offset=100V")
     p.add_argument("--duration", type=float, help="simulated time of each rollout (s; a step needs one)")
     p.add_argument("--set", action="append", metavar="NAME=VALUE",
@@ -661,12 +703,13 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0, help="seed of the starts / the evolution")
     p.add_argument("--max-evaluations", type=int, default=400, help="at most this many evaluations (default 400)")
     p.add_argument("--out", default="out/optimize",
-                   help="folder for result.json, evaluations.csv (a rerun reads it as a cache) and optimum.toml")
+                   help="folder for result.json, evaluations.csv (a rerun reads it as a cache), optimum.toml and, with "
+                        "the report extra, optimize.png (and pareto.csv, pareto.png)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_optimize)
     p = sub.add_parser("identify", help="fit the papers' models to measured data (CSV with a header)")
     isub = p.add_subparsers(dest="what", required=True)
-    q = isub.add_parser("step", help="seed 000: transfer function from a curvature step response")
+    q = isub.add_parser("step", help="Dadras et al. 2021: transfer function from a curvature step response")
     q.add_argument("file")
     q.add_argument("--voltage", type=float, required=True, help="step amplitude (V)")
     q.add_argument("--t-step", type=float, default=0.0, help="time of the step (s)")
@@ -678,7 +721,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="with --actuator: an rc-relaxation parameter the step does not identify (capacitance)")
     q.add_argument("--out", help=f"with --actuator: the identified actuator file (default {IDENTIFIED})")
     q.set_defaults(func=cmd_identify_step)
-    q = isub.add_parser("hinges", help="seed 001: joint stiffness and damping from a tip trajectory")
+    q = isub.add_parser("hinges", help="Mutlu et al. 2013: joint stiffness and damping from a tip trajectory")
     add_scene_args(q)
     q.add_argument("file")
     q.add_argument("--voltage", required=True, help="the waveform applied during the measurement")
@@ -692,10 +735,30 @@ def build_parser() -> argparse.ArgumentParser:
     return ap
 
 
+def _told(func):
+    """Run ``func`` with a material's range warnings (a layer's value, a field past its
+    limit: :class:`mjeap.model.materials.RangeWarning`) told as one line each,
+    ``mjeap: warning: ...``, once per text; other warnings as Python tells them."""
+    import warnings
+    from .model.materials import RangeWarning
+    told, plain = set(), warnings.showwarning
+
+    def show(message, category, filename, lineno, file=None, line=None):
+        if not issubclass(category, RangeWarning):
+            return plain(message, category, filename, lineno, file, line)
+        if str(message) not in told:
+            told.add(str(message))
+            print(f"mjeap: warning: {message}", file=sys.stderr)
+
+    with warnings.catch_warnings():
+        warnings.showwarning = show
+        return func()
+
+
 def main(argv: Optional[List[str]] = None) -> int:
     def command() -> int:
         args = build_parser().parse_args(argv)
-        return args.func(args)
+        return _told(lambda: args.func(args))
     return run_command(command)
 
 

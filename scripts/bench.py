@@ -4,7 +4,7 @@
 models: steps per second and real-time factor of every catalog actuator at its default
 discretisation, both representations, unforced (MuJoCo's own stepping loop, one thread).
 
-rollout: seed 000's heaviest experiment (pedot-micro, 12.6 mg at 6.27 mm, standing up,
+rollout: Dadras et al. 2021's heaviest experiment (pedot-micro, 12.6 mg at 6.27 mm, standing up,
 3 Vpp square wave at 0.1 Hz, 20 s) with the drive and the recording on: wall time and
 real-time factor, the drive's own cost per step, and the peak-to-peak tip curvature
 against a run at half the timestep and twice the segments.
@@ -24,13 +24,13 @@ error as its accuracy target.
 sweep: rollouts per second of a 16-point sweep on 1 and 2 local worker processes, and the
 memory of one rollout.
 
-native: seed 000's drive compiled into the model (mjeap.drives.native) against the lockstep loop,
+native: Dadras et al. 2021's drive compiled into the model (mjeap.drives.native) against the lockstep loop,
 side by side: the heaviest experiment as one rollout, a batch of 16 on 2 threads against the
 loop one by one, mj_step of the native model against the bare beam, and the stability
 map's 30 s points per second on 2 workers with either engine.
 
 accuracy: runs at a stated accuracy (mjeap.simulation.accuracy) against the default model, side by
-side: seed 000's heaviest run at 1e-2 and 1e-3 (wall, estimated and true error), a batch of
+side: Dadras et al. 2021's heaviest run at 1e-2 and 1e-3 (wall, estimated and true error), a batch of
 16 at 1e-2 on 2 threads against the loop one by one, the stability map's points at 1e-2,
 where the native step's time goes (MuJoCo's timers) and the accuracy claim on seeded cases.
 
@@ -45,6 +45,11 @@ SLSQP (3 starts) and differential evolution, evaluations, wall and their error a
 beside them the grid sweep of the same two metrics whose spacing is the 1 % the test asks of
 the optimiser (2 workers), its best feasible point's error and wall, and the number of grid
 points a sweep would need to match each optimiser's own error.
+
+show: mjeap show's time per file (the catalog and examples/actuators): the first describe()
+of each file in one process (the designer's first numbers from closed forms and the
+linearised model, the scene built) and the best of three more; and the whole command in a
+fresh process, beside importing the package alone (what a cold start costs).
 """
 import argparse
 import json
@@ -128,15 +133,20 @@ def bench_rollout(tmpdir):
             "fine": {"timestep_s": fine.timestep, "segments": fine.layout.segments}}
 
 
+#: drives no catalog actuator uses, timed on an example file
+EXAMPLE_ACTUATORS = {"piezo": "examples/actuators/laminate/pzt-hamr-small.toml"}
+
+
 def bench_drives(n=20000):
     """Drive step cost (us), 20 hinges, the voltage alternating every step (worst case for
     drives that cache on it)."""
     from mjeap.drives import DRIVES, make_drive
     rows = []
     for name, cls in DRIVES.items():
-        if not cls.actuators:           # a drive no catalog actuator uses ('none'): nothing to time
+        example = EXAMPLE_ACTUATORS.get(name)
+        if not cls.actuators and example is None:   # a drive no actuator uses ('none'): nothing to time
             continue
-        s = Scene(cls.actuators[0])
+        s = Scene(cls.actuators[0] if cls.actuators else str(Path(__file__).resolve().parent.parent / example))
         drv = make_drive(name, s)
         drv.reset(0.0)
         lo, hi = drv.voltage_range()
@@ -150,6 +160,37 @@ def bench_drives(n=20000):
                      "step_us": (time.perf_counter() - t0) / n * 1e6,
                      "open_loop": drv.closed_loop_reason() is None})
     return rows
+
+
+def bench_show(repeats=3):
+    """mjeap show per file (module text): seconds of describe() first and warm, and of the
+    command in a fresh process beside the import alone."""
+    import subprocess
+    from mjeap.cli import describe
+    from mjeap.model.catalog import CATALOG
+    root = Path(__file__).resolve().parent.parent
+    files = list(CATALOG) + sorted(str(p.relative_to(root)) for p in (root / "examples" / "actuators").rglob("*.toml"))
+    rows = []
+    for f in files:
+        t0 = time.perf_counter()
+        describe(str(root / f) if f.endswith(".toml") else f)
+        first = time.perf_counter() - t0
+        again = []
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            describe(str(root / f) if f.endswith(".toml") else f)
+            again.append(time.perf_counter() - t0)
+        rows.append({"file": f, "first_s": first, "again_s": min(again)})
+    cold = {}
+    for what, argv in (("import_s", [sys.executable, "-c", "import mjeap.cli"]),
+                       ("command_s", [sys.executable, "-m", "mjeap.cli", "show", "pzt-hamr-small"])):
+        best = []
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            subprocess.run(argv, cwd=root, check=True, capture_output=True)
+            best.append(time.perf_counter() - t0)
+        cold[what] = min(best)
+    return {"files": rows, "fresh_process": {"file": "pzt-hamr-small", **cold}}
 
 
 def bench_threaded():
@@ -215,7 +256,7 @@ def _mjeap_cantilever(b, T, P, segments, drive=None, repeats=3, engine="loop"):
 
 
 def _mjeap_at_accuracy(T, P, target, ref, repeats=3):
-    """The same cantilever with seed 000's drive running, mjeap choosing its model for
+    """The same cantilever with Dadras et al. 2021's drive running, mjeap choosing its model for
     ``target`` (mjeap.simulation.accuracy, its quantity sampled at the end only: the settled tip arc's
     curvature against a converged model, relative to its change). The chosen model is then
     built once (as the rod is) and its run timed as the others; its tip is checked against
@@ -330,7 +371,7 @@ def bench_elastica(T=0.05, elements=20, with_pyelastica=True):
                                          for d in ("blocking-force", "rc-relaxation")],
            "mjeap_with_native_drive": err(_mjeap_cantilever(b, T, P, 20, drive="rc-relaxation", engine="native"))}
     out["mjeap_with_drive_callback"][0]["drive"] = "blocking-force at 0 V (no moment): the callback's cost alone"
-    out["mjeap_with_drive_callback"][1]["drive"] = ("rc-relaxation at 0 V: seed 000's drive; its back-relaxation "
+    out["mjeap_with_drive_callback"][1]["drive"] = ("rc-relaxation at 0 V: Dadras et al. 2021's drive; its back-relaxation "
                                                     "creeps the beam, so the tip is not the elastic one")
     out["mjeap_with_native_drive"]["drive"] = ("rc-relaxation compiled into the model (mjeap.drives.native, Maxwell arms), "
                                                "on mujoco.rollout")
@@ -463,7 +504,7 @@ def _step_phases(model, data, n=20000) -> dict:
 
 def bench_accuracy(claim_cases=12):
     """Runs at a stated accuracy (mjeap.simulation.accuracy) against today's default model, side by side:
-    seed 000's heaviest run (wall of all runs, estimated and true error against 40 segments
+    Dadras et al. 2021's heaviest run (wall of all runs, estimated and true error against 40 segments
     at 1/60 of the 10 ms sample grid under discrete), a batch of 16 at 1e-2 on 2 threads
     against the loop one by one, the stability map's points at 1e-2, where the native
     step's time goes, and the accuracy claim on seeded cases."""
@@ -685,7 +726,7 @@ def bench_optimize(f_min=800.0, box=(5e-3, 15e-3), resolution=0.01):
 
 def bench_warp(map_points=4, duration=1.0, batch=16, batch_duration=0.6):
     """The warp engine against the native one on this machine (Warp's CPU device unless a GPU
-    is found; the device is in the output): a batch of seed 000's standing run with 16
+    is found; the device is in the output): a batch of Dadras et al. 2021's standing run with 16
     amplitudes, and a small stability map (``map_points`` points of ``duration`` s, serial)."""
     import tempfile
     from mjeap import Payload, rollout_batch
@@ -718,7 +759,7 @@ def bench_warp(map_points=4, duration=1.0, batch=16, batch_duration=0.6):
 
 
 BENCHMARKS = ("models", "rollout", "drives", "threaded", "elastica", "sweep", "native", "accuracy", "metric_map",
-              "early_stop", "optimize", "warp")
+              "early_stop", "optimize", "warp", "show")
 
 
 def main(argv=None):
@@ -772,6 +813,8 @@ def main(argv=None):
             out["optimize"] = bench_optimize()
         elif name == "warp":
             out["warp"] = bench_warp()
+        elif name == "show":
+            out["show"] = bench_show()
         emit()
     print(emit())
 

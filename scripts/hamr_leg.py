@@ -1,4 +1,4 @@
-"""HAMR single leg (seed 003, section 6.2): resonances, foot ellipse, phase loops.
+"""HAMR single leg (Jayaram et al. 2018, section 6.2): resonances, foot ellipse, phase loops.
 
 The experiment lives in :mod:`mjeap.robots.hamr_leg`; this is its command line, the same as
 ``mjeap robot hamr-leg``:

@@ -1,4 +1,4 @@
-"""HAMR-VI walks (seed 003, section 6.2): the whole quadruped trotting open loop on a ground
+"""HAMR-VI walks (Jayaram et al. 2018, section 6.2): the whole quadruped trotting open loop on a ground
 plane; speed against frequency, the paper's 0.5 m/s at 65 Hz, slip, attitude.
 
 The experiment lives in :mod:`mjeap.robots.hamr_walk`; this is its command line, the same as

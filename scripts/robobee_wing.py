@@ -1,4 +1,4 @@
-"""RoboBee wing (seed 003, section 6.1): stroke against frequency and the self-sensed stroke.
+"""RoboBee wing (Jayaram et al. 2018, section 6.1): stroke against frequency and the self-sensed stroke.
 
 The experiment lives in :mod:`mjeap.robots.robobee_wing`; this is its command line, the same as
 ``mjeap robot robobee-wing``:

@@ -1,5 +1,5 @@
-"""Stability map of the PEDOT micro trilayer standing up (seed 000): payload mass x drive
-amplitude, each point a 0.1 Hz square-wave rollout judged by seed 000's criterion (the tip
+"""Stability map of the PEDOT micro trilayer standing up (Dadras et al. 2021): payload mass x drive
+amplitude, each point a 0.1 Hz square-wave rollout judged by Dadras et al. 2021's criterion (the tip
 curvature still changes sign in the third period), run as an mjeap sweep.
 
     python scripts/stability_map.py [--out out/stability] [--workers 2] [--executor processes|dask]

@@ -124,7 +124,16 @@ def _generic(name, d) -> str:
     return f"**{name}**\n\n" + _table(["key", "value"], rows)
 
 
-FORMATS = {"models": _models, "rollout": _rollout, "drives": _drives, "threaded": _threaded, "sweep": _sweep,
+def _show(d) -> str:
+    fresh = d.get("fresh_process", {})
+    return ("**show**: `mjeap show` per file, the designer's first numbers from closed forms and the linearised "
+            "model: the first call in a process and the best of three more; a fresh process runs the command in "
+            f"{_num(fresh.get('command_s'))} s, of which importing the package takes {_num(fresh.get('import_s'))} s."
+            "\n\n" + _table(["file", "first (s)", "again (s)"],
+                             [[f"`{r['file']}`", _num(r["first_s"]), _num(r["again_s"])] for r in d.get("files", [])]))
+
+
+FORMATS = {"show": _show, "models": _models, "rollout": _rollout, "drives": _drives, "threaded": _threaded, "sweep": _sweep,
            "native": _native}
 
 

@@ -1,6 +1,6 @@
 """Documented calibrations of unknowns the sources leave open.
 
-:func:`calibrate_tip_mass`: seed 003's bimorphs, built from their physical parameter set
+:func:`calibrate_tip_mass`: Jayaram et al. 2018's bimorphs, built from their physical parameter set
 (effective moduli, layer thicknesses, alumina tip blocks; see the catalog), still resonate
 above Table 1. One labelled residual per type closes the gap: mass added to the rigid tip
 block at fixed block length, fitted (scipy brentq) so that the scene's first mode equals the

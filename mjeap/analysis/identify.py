@@ -1,10 +1,10 @@
 """System identification the way the source papers do it, on measured or simulated data (SI).
 
-* :func:`fit_step_response` (seed 000, eqs. 7-8): a curvature step response fitted by two
+* :func:`fit_step_response` (Dadras et al. 2021, eqs. 7-8): a curvature step response fitted by two
   exponentials, kappa(t) = A + B exp(-p t) + C exp(-a t); the fast pole a is electrical
   (1/RC), the slow pole p and a zero z mechanical (back-relaxation), the initial curvature
   decays on the mechanical pole. Returns the transfer function and a drive that runs it.
-* :func:`fit_hinge_parameters` (seed 001): joint stiffness and damping of the hinge chain
+* :func:`fit_hinge_parameters` (Mutlu et al. 2013): joint stiffness and damping of the hinge chain
   fitted to a measured tip trajectory by nonlinear least squares (scipy.optimize), the chain
   itself (a :class:`~mjeap.simulation.scene.Scene`) being the model.
 * :func:`read_columns`: a user's CSV, checked (columns present, time increasing, finite,
@@ -85,7 +85,7 @@ def read_columns(path: Union[str, Path], columns: Sequence[str], min_samples: in
     return {columns[0]: t, **dict(zip(columns[1:], rest))}
 
 
-# ---------------------------------------------------------------- seed 000: step response
+# ---------------------------------------------------------------- Dadras et al. 2021: step response
 @dataclass(frozen=True)
 class StepFit:
     """kappa(t) = A + B exp(-p t) + C exp(-a t) after a step of ``voltage`` V at t = 0, and
@@ -123,7 +123,7 @@ class StepFit:
 
 def fit_step_response(time, curvature, voltage: float, t_step: float = 0.0) -> StepFit:
     """Fit a curvature step response (time in s, curvature in 1/m, the step of ``voltage`` V
-    applied at ``t_step``) as seed 000 does (eq. 7) and derive eq. (8)'s form.
+    applied at ``t_step``) as Dadras et al. 2021 does (eq. 7) and derive eq. (8)'s form.
 
     From the step response of gain (s + z)/((s + p)(s + a)) x V/s plus the zero-input term
     kappa0 exp(-p t): A = g V z/(p a), C = g V (z - a)/(a (a - p)), hence
@@ -180,7 +180,7 @@ def _step_fit(model, best, t, voltage) -> "StepFit":
                    float(A + B + C), rms)
 
 
-# ---------------------------------------------------------------- seed 001: joint stiffness and damping
+# ---------------------------------------------------------------- Mutlu et al. 2013: joint stiffness and damping
 @dataclass(frozen=True)
 class HingeFit:
     stiffness: float             # N m / rad, every hinge
@@ -207,7 +207,7 @@ def fit_hinge_parameters(scene, time, tip_deflection, voltage, drive=None, drive
     """Fit one stiffness and one damping for every hinge of ``scene`` (a hinge chain) so that
     its tip deflection under ``voltage`` (waveform) follows the measured ``tip_deflection``
     (m) at ``time`` (s), by nonlinear least squares (scipy.optimize.least_squares on the
-    logarithms; seed 001 identifies its 16-link chain this way). ``initial`` = (k, b) start,
+    logarithms; Mutlu et al. 2013 identifies its 16-link chain this way). ``initial`` = (k, b) start,
     default the scene's own values. The scene's hinges are left at the fitted values."""
     t, y = check_series(time, tip_deflection, names=["tip_deflection"])
     if np.ptp(y) == 0:
@@ -240,7 +240,7 @@ def fit_hinge_parameters(scene, time, tip_deflection, voltage, drive=None, drive
 
 
 # ---------------------------------------------------------------- what was identified, into an actuator
-#: the drive whose parameters a step fit identifies (seed 000, eq. 8)
+#: the drive whose parameters a step fit identifies (Dadras et al. 2021, eq. 8)
 STEP_DRIVE = "rc-relaxation"
 #: the identified file must reproduce the fitted tip trajectory to this fraction of its swing
 REPRODUCE = 0.02
@@ -289,7 +289,7 @@ def step_actuator(act, fit: StepFit, data: str, given: Optional[Dict[str, tuple]
     sourced to the ``data`` file it was identified from; the drive's other parameters the
     file's own (same drive) or ``given``. The initial curvature is a state, not written."""
     rows = step_rows(act, given)
-    how = (f"identified from {data} (mjeap identify step: seed 000 eqs. 7-8 fitted to a {fit.voltage:g} V step, "
+    how = (f"identified from {data} (mjeap identify step: Dadras et al. 2021 eqs. 7-8 fitted to a {fit.voltage:g} V step, "
            f"rms residual {fit.rms_residual:.3g} 1/m)")
     fitted = {k: (float(v), "", how) for k, v in fit.drive_parameters().items()}
     rows = {**fitted, **{k: v for k, v in rows.items() if k not in fitted}}
@@ -314,7 +314,7 @@ def hinge_actuator(scene, fit: HingeFit, data: str, drive: Optional[str] = None,
     act = scene.actuator
     drive = drive or default_drive_name(act)
     n, ds = scene.layout.segments, scene.layout.ds
-    how = f"identified from {data} (mjeap identify hinges: seed 001's joint fit on {n} hinges"
+    how = f"identified from {data} (mjeap identify hinges: Mutlu et al. 2013's joint fit on {n} hinges"
     EI = Sourced(fit.stiffness * ds, "N m^2",
                  f"{how}, k = {fit.stiffness:.4g} +- {fit.stiffness_std:.2g} N m/rad at every hinge; EI = k L/N, "
                  "uniform along the beam)")

@@ -1,4 +1,4 @@
-"""Tip-curvature tracking for the loaded PEDOT actuator (seed 000), written against mjeap's
+"""Tip-curvature tracking for the loaded PEDOT actuator (Dadras et al. 2021), written against mjeap's
 public API only.
 
 Feedforward: the inverse of the identified transfer function (eq. 8, or any

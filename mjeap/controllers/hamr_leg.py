@@ -1,4 +1,4 @@
-"""HAMR leg phase control from the actuator's own current (Jayaram et al. 2018, seed 003,
+"""HAMR leg phase control from the actuator's own current (Jayaram et al. 2018, Jayaram et al. 2018,
 section 6.2), written against mjeap's public API only.
 
 Scene: the HAMR small bimorph (catalog residual tip mass fitted to its measured 1750 Hz) drives one
@@ -53,7 +53,7 @@ class Transmission:
 
 
 SWING = Transmission("swing", 13.0, 100.0, 0.0)
-#: the lift, 90 degrees ahead of the swing: the foot traces the ellipse of seed 003 (ref. [50])
+#: the lift, 90 degrees ahead of the swing: the foot traces the ellipse of Jayaram et al. 2018 (ref. [50])
 LIFT = Transmission("lift", 12.0, 80.0, np.pi / 2)
 
 

@@ -1,10 +1,10 @@
 """Self-sensing tip velocity of a piezoelectric bimorph from its own drive current
-(Jayaram et al. 2018, seed 003, eqs. 7-9), written against mjeap's public API only.
+(Jayaram et al. 2018, Jayaram et al. 2018, eqs. 7-9), written against mjeap's public API only.
 
     I_sen = I_act - (2 V - V_bias) / (2 R_fit) - beta C_fit dV/dt      (eq. 7)
     v_sen = alpha I_sen                                                (eq. 9)
 
-R_fit and C_fit are the dielectric resistance and capacitance the user measured (seed 003:
+R_fit and C_fit are the dielectric resistance and capacitance the user measured (Jayaram et al. 2018:
 on a fixed actuator) or took from a datasheet. The blocking factor beta corrects C_fit to
 the free actuator's capacitance and is fitted once (eq. 8): the value that minimises the
 squared phase difference between the measured tip velocity and I_sen over a frequency
@@ -161,7 +161,7 @@ def calibrate(sweep: SineSweep, bias: float, r_fit: float, c_fit: float,
 
 def calibrate_on_free_actuator(actuator, bias: float, frequencies, **scene_kw) -> SelfSensingEstimator:
     """Eqs. 7-9 calibrated once on the free (unloaded) ``actuator``'s sine sweep at ``bias``
-    (V) over ``frequencies`` (Hz), as seed 003 calibrates on the bench, not on the robot:
+    (V) over ``frequencies`` (Hz), as Jayaram et al. 2018 calibrates on the bench, not on the robot:
     the drive's own resistance and capacitance stand in for the user's fixed-actuator
     measurement (Table 2's extracted fits are unreliable), beta by eq. 8. ``scene_kw`` go to
     the free actuator's :class:`mjeap.Scene`."""
@@ -176,7 +176,7 @@ def calibrate_on_free_actuator(actuator, bias: float, frequencies, **scene_kw) -
 
 def quasi_static_alpha(length: float, extension: float, area: float, f31: float, t_p: float, t_cf: float) -> float:
     """alpha (m/(A s)) of the uniform-curvature bimorph: the tip velocity (L/2 + l_ext) L kappa'
-    over the motional current of seed 003's eq. (13), 2 A f31 eps_1' with the plate's mid-plane
+    over the motional current of Jayaram et al. 2018's eq. (13), 2 A f31 eps_1' with the plate's mid-plane
     strain eps_1 = kappa (t_p + t_cf)/2 over the PZT area A; the counterpart of the paper's
     eq. (17b), which averages 1/y over the plate instead and leaves out the tip block."""
     return length * (0.5 * length + extension) / (f31 * (t_p + t_cf) * area)

@@ -1,4 +1,4 @@
-"""Blocking-force drive for the PPy trilayer (Mutlu, Alici, Li 2013, seed 001).
+"""Blocking-force drive for the PPy trilayer (Mutlu, Alici, Li 2013, Mutlu et al. 2013).
 
 The measured blocking force F_B(t, V) becomes a uniform internal moment
 M = (2/3) F_B L at every joint (the moment whose free beam, held at the tip, pushes with
@@ -18,7 +18,7 @@ from ..errors import ParameterError
 from ..model import lti
 from .base import Drive, NativeForm, OpenLoop, ExactLTI, register_drive
 
-_EST = "estimate (seed 001 gives no extractable number; actuator reference: a few tenths of a mN to ~1 mN at 1 V)"
+_EST = "estimate (Mutlu et al. 2013 gives no extractable number; actuator reference: a few tenths of a mN to ~1 mN at 1 V)"
 
 
 class VoltageTable:
@@ -45,7 +45,7 @@ class BlockingForceDrive(OpenLoop, NativeForm, Drive):
     #: the ppy-trilayer's values (also in its actuator file), the defaults for any actuator
     GENERIC_PARAMETERS = {
         "blocking_force_per_volt": (0.5e-3, "N/V", _EST),
-        "time_constant": (2.0, "s", "estimate (PPy trilayers of this size settle in seconds; not extractable from seed 001)"),
+        "time_constant": (2.0, "s", "estimate (PPy trilayers of this size settle in seconds; not extractable from Mutlu et al. 2013)"),
     }
     RANGES = {"time_constant": (0.0, np.inf)}
 

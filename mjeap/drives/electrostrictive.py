@@ -1,4 +1,4 @@
-"""Electrostrictive terpolymer unimorph (Metello 2020, seed 002).
+"""Electrostrictive terpolymer unimorph (Metello 2020, Metello 2020).
 
 Two models, chosen with ``model=``:
 
@@ -33,7 +33,7 @@ from ..errors import ParameterError
 from .base import Drive, OpenLoop, register_drive
 
 EPS0 = 8.8541878128e-12
-_T = "Metello 2020 (seed 002)"
+_T = "Metello 2020"
 #: measured tip stiffness (N/mm) at 0, 8.33, 11.67, 15 MV/m, Tables 4.1-4.4
 SLOPES = {"pvdf-60": (4.70e-4, 1.01e-3, 1.19e-3, 1.16e-3),
           "pvdf-60-half": (2.80e-4, 5.70e-4, 6.00e-4, 6.20e-4),

@@ -10,7 +10,7 @@ viewer (the voltage is a slider), in ``mujoco.rollout`` and in batched engines:
   piezo bimorph's width-proportional moment is coefficients w_j / w_0;
 * first-order electrical dynamics are the actuator's activation (``dyntype="filterexact"``:
   exact for a voltage held over the step, as the loop drives step it);
-* seed 000's standard-linear-solid back-relaxation is one Maxwell arm per hinge (see
+* Dadras et al. 2021's standard-linear-solid back-relaxation is one Maxwell arm per hinge (see
   :func:`add_maxwell_arms`).
 
 Conventions every generated model follows: the custom numeric ``mjeap_units`` holds
@@ -77,12 +77,12 @@ def add_maxwell_arms(spec: mujoco.MjSpec, joints, parent: str, k, zero: float, p
     spring k (z - p)/z (a fixed tendon theta_j - r_j) in series with a damper
     k (z - p)/z^2 on a relaxation dof r_j. Instantaneous stiffness k, relaxed k p/z,
     relaxation rate z: the moment of every load the beam carries (drive, payload,
-    gravity) relaxes, as seed 000's mechanical block (s + z)/(s + p) says. The damper is
+    gravity) relaxes, as Dadras et al. 2021's mechanical block (s + z)/(s + p) says. The damper is
     implicit under ``implicitfast``; the relaxation dof's armature is RELAXATION_INERTIA x
     (timestep x damping), so the arm is first order to 1e-3 of a step; its body (on the
     hinge axis, under ``parent``) weighs RELAXATION_BODY_MASS x ``link_mass``.
 
-    Cost, measured on seed 000's 20-hinge beam (MuJoCo 3.17, this 2-core machine, mj_step):
+    Cost, measured on Dadras et al. 2021's 20-hinge beam (MuJoCo 3.17, this 2-core machine, mj_step):
     bare beam 5.5 us, with the drive's tendon and actuator 6.4, with the arms 9.2-9.5; of
     the arms, their 20 dofs take 2.4 us and their 20 tendons 0.7; their bodies nothing
     measurable (six arms' joints on one body: the same time). The tendon-free form, a second

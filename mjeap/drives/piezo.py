@@ -1,4 +1,4 @@
-"""PZT-5H bending bimorph under unipolar simultaneous drive (Jayaram 2018, seed 003).
+"""PZT-5H bending bimorph under unipolar simultaneous drive (Jayaram 2018, Jayaram et al. 2018).
 
 A constant bias V_bias sits across the outer electrodes and the drive signal V_sig in
 [0, V_bias] on the centre layer, so the two plates see V_bias - V_sig and V_sig, and the
@@ -15,7 +15,7 @@ Moment per volt, derived three ways (they agree; the factor was 1/2 before issue
    Harvard's HAMR actuator model (PZTBender2.m) writes the same as forces Ft - Fb that are
    proportional to the plates' voltage difference V = 2 V_sig - V_bias, which is the V of
    the closed forms in ``mjeap.model.analytical`` (V_bias at full drive).
-2. Seed 003 eq. (13): I_mech = 2 A f31 d(eps_1)/dt, eps_1 the bending strain of one plate,
+2. Jayaram et al. 2018 eq. (13): I_mech = 2 A f31 d(eps_1)/dt, eps_1 the bending strain of one plate,
    kappa (t_p + t_cf) / 2 at its mid-plane. Over a hinge j of width w_j and rotation theta_j
    (A eps_1 summed as w_j l_j kappa_j (t_p + t_cf)/2 = w_j theta_j (t_p + t_cf) / 2):
    I_mech = sum_j Gamma_j dtheta_j/dt with Gamma_j = f31 w_j (t_p + t_cf).
@@ -69,74 +69,43 @@ from ..model import analytical as an
 from .base import Drive, NativeForm, OpenLoop, register_drive
 
 _J = "Jafferis et al. 2015: f31 ~ 32 Pa m/V free (24 blocked)"
-_C = ("estimate: seed 003 measures about half the 16 nF datasheet value for a fixed HAMR actuator; "
+_C = ("estimate: Jayaram et al. 2018 measures about half the 16 nF datasheet value for a fixed HAMR actuator; "
       "8 nF scaled with the PZT area (Table 1)")
 _R = "illustrative: the extracted fits of eq. 4a are unreliable (actuator reference); refit before use"
 
 
 def _params(area_mm2: float):
-    return {"bias": (200.0, "V", "seed 003: 25-200 V tested"),
+    return {"bias": (200.0, "V", "Jayaram et al. 2018: 25-200 V tested"),
             "f31": (32.0, "Pa m/V", _J),
             "capacitance": (8e-9 * area_mm2 / 32.2, "F", _C),
             "resistance": (1e9, "ohm", _R)}
 
 
-@register_drive
-class PiezoBimorphDrive(OpenLoop, NativeForm, Drive):
-    name = "piezo-bimorph"
-    actuators = ("pzt-hamr-large", "pzt-hamr-small", "pzt-robobee")
-    model_used = "unipolar simultaneous drive, Wood/Jafferis effective stress"
-    #: a core with a piezo layer of equal thickness either side (:meth:`stack_reason`);
-    #: the catalog bimorphs' parameters are in their actuator files
-    ROLES = {"piezo": 2, "core": 1}
-    GENERIC_PARAMETERS = _params(32.2)
-    RANGES = {"bias": (0.0, 200.0 + 1e-9), "f31": (0.0, np.inf), "capacitance": (0.0, np.inf),
-              "resistance": (0.0, np.inf)}
+class LinearPiezo(OpenLoop, NativeForm, Drive):
+    """What the piezo drives share (this module's text): moments linear in the held voltage,
+    M_j = Gamma_j (V - V_0) at hinge j (or Gamma_j V + M0_j where the rest voltage differs
+    from hinge to hinge), and the current of the voltage held over the last step at that
+    voltage's instant: resistive, capacitive (C times the causal second-order difference)
+    and motional (sum_j Gamma_j times the hinges' central rate). A subclass calls
+    :meth:`_couple` from its ``__init__`` and gives :meth:`resistive_current`."""
 
-    def __init__(self, scene, **params):
-        super().__init__(scene, **params)
-        act = scene.actuator
-        self.t_p, self.t_cf = self.stack(act)
-        w = scene.layout.hinge_width
-        self.gamma = self.params["f31"] * w * (self.t_p + self.t_cf)   # N m / V per hinge (module text)
+    def _couple(self, gamma, v0: float, m0=None, capacitance: float = 0.0) -> None:
+        """Gamma_j (N m/V per hinge), the rest voltage V_0 (V), per-hinge offsets M0_j (N m;
+        None: M_j = Gamma_j (V - V_0)) and the dielectric capacitance (F)."""
+        n = self.scene.layout.segments
+        self.gamma = np.asarray(gamma, float)
+        self._v0, self._m0, self._capacitance = float(v0), None if m0 is None else np.asarray(m0, float), \
+            float(capacitance)
         self._v_prev = self._v_prev2 = None     # the voltages held over the last two steps, V
         self._v = self._dv = 0.0
-        self._m = np.zeros(scene.layout.segments)
-        self._rates = np.zeros(scene.layout.segments)
-        self._rates_before = np.zeros(scene.layout.segments)
-        self._half_bias = 0.5 * float(self.params["bias"])
+        self._m = np.zeros(n)
+        self._rates = np.zeros(n)
+        self._rates_before = np.zeros(n)
         self._i_before = None                   # whether _rates_before holds the rates before the last step
 
-    @staticmethod
-    def stack(actuator):
-        """(t_p, t_cf) (m): a piezo layer's and the core's thickness of a symmetric bimorph."""
-        roles = [l.role for l in actuator.layers]
-        return actuator.layers[roles.index("piezo")].thickness, actuator.layers[roles.index("core")].thickness
-
-    @classmethod
-    def stack_reason(cls, actuator):
-        """The bimorph's stack: exactly one 'core' layer with one 'piezo' layer of equal
-        thickness either side of it (the moment per volt and the closed forms assume it)."""
-        why = super().stack_reason(actuator)
-        if why is not None:
-            return why
-        roles = [l.role for l in actuator.layers]
-        core = [i for i, r in enumerate(roles) if r == "core"]
-        piezo = [i for i, r in enumerate(roles) if r == "piezo"]
-        layers = ", ".join(f"{l.name} ({l.role or 'no role'})" for l in actuator.layers)
-        if len(core) != 1 or len(piezo) != 2 or not piezo[0] < core[0] < piezo[1]:
-            return f"it needs one 'core' layer between two 'piezo' layers; {actuator.id} has {layers}"
-        t1, t2 = (actuator.layers[i].thickness for i in piezo)
-        if abs(t1 - t2) > 1e-9 * max(t1, t2):
-            return f"its two 'piezo' layers must be equally thick (a symmetric bimorph); they are {t1:g} and {t2:g} m"
-        return None
-
-    def voltage_range(self):
-        return (0.0, float(self.params["bias"]))
-
     def rest_voltage(self) -> float:
-        """V_sig = V_bias / 2: both plates see the same field, V_eff = 0."""
-        return 0.5 * self.params["bias"]
+        """The voltage at which the drive applies no moment (V_0)."""
+        return self._v0
 
     def reset(self, initial_curvature: float = 0.0) -> None:
         self._v_prev = self._v_prev2 = None
@@ -148,7 +117,11 @@ class PiezoBimorphDrive(OpenLoop, NativeForm, Drive):
 
     def step(self, voltage: float, dt: float) -> None:
         part = self.part
-        np.multiply(self.gamma, voltage - self._half_bias, out=self._m)
+        if self._m0 is None:
+            np.multiply(self.gamma, voltage - self._v0, out=self._m)
+        else:
+            np.multiply(self.gamma, voltage, out=self._m)
+            np.add(self._m, self._m0, out=self._m)
         part.set_internal_moments(self._m)
         # dV/dt at the held voltage's instant t_k (module text): before the first step the
         # first voltage is taken as held
@@ -170,11 +143,16 @@ class PiezoBimorphDrive(OpenLoop, NativeForm, Drive):
 
     # -- native form: a fixed-gain actuator on the bending tendon -------------------------
     def native_reason(self):
+        if self._m0 is not None:
+            return ("its rest voltage differs from hinge to hinge (layers of their own widths move the neutral "
+                    "axis along the beam), which one actuator on the bending tendon cannot apply")
+        if not np.all(self.gamma != 0):
+            return "its moment per volt is zero at some hinge"
         return None
 
     def add_native(self, spec, joints, parent):
-        """M_j = Gamma_j (V - V_bias/2): tendon coefficients Gamma_j / Gamma_0 (the width
-        ratios), gain Gamma_0 and bias -Gamma_0 V_bias / 2; a tendon-velocity sensor
+        """M_j = Gamma_j (V - V_0): tendon coefficients Gamma_j / Gamma_0 (the width
+        ratios), gain Gamma_0 and bias -Gamma_0 V_0; a tendon-velocity sensor
         ``bend_rate`` gives the motional current Gamma_0 x its reading (the custom numeric
         ``mjeap_coupling`` holds Gamma_0 in N m/V, i.e. A s)."""
         from . import native
@@ -188,11 +166,17 @@ class PiezoBimorphDrive(OpenLoop, NativeForm, Drive):
         return native.NativeHandles(sensors={"motional_rate": "bend_rate"})
 
     def _moment_history(self, v):
-        return np.multiply.outer(v - 0.5 * self.params["bias"], self.gamma)
+        if self._m0 is None:
+            return np.multiply.outer(v - self._v0, self.gamma)
+        return np.multiply.outer(v, self.gamma) + self._m0
 
     def _restore_before(self, k: int) -> None:
         self._v_prev = None if k == 0 else float(self._v_history[k - 1])
         self._v_prev2 = None if k == 0 else float(self._v_history[max(k - 2, 0)])
+
+    def resistive_current(self, v: float) -> float:
+        """The leakage current (A) at the held voltage ``v`` (V)."""
+        raise NotImplementedError
 
     def currents(self):
         """(resistive, capacitive, motional) current of eq. (1), A, of the voltage held over
@@ -200,17 +184,124 @@ class PiezoBimorphDrive(OpenLoop, NativeForm, Drive):
         second-order difference (3 V_k - 4 V_{k-1} + V_{k-2}) / 2h, and the hinges' central
         rate, the mean of their rates before and after the step (module text; before any
         step, the rates now)."""
-        vb = self.params["bias"]
         now = float(np.dot(self.gamma, self.part.hinge_rates(self._rates)))
         before = float(np.dot(self.gamma, self._rates_before)) / self.part.units.time
         i_mech = now if self._i_before is None else 0.5 * (before + now)
-        return ((2 * self._v - vb) / (2 * self.params["resistance"]), self.params["capacitance"] * self._dv, i_mech)
+        return self.resistive_current(self._v), self._capacitance * self._dv, i_mech
 
     def signals(self) -> Dict[str, float]:
         i_r, i_c, i_m = self.currents()
         return {"current (A)": i_r + i_c + i_m, "current_resistive (A)": i_r,
                 "current_capacitive (A)": i_c, "current_motional (A)": i_m,
                 "drive_moment_root (N m)": float(self._m[0])}
+
+    # -- the laminate: fields, stresses and capacitances (mjeap.model.laminate) -------------
+    def laminate(self):
+        """The actuator's layer stack wired as this drive wires it
+        (:class:`mjeap.model.laminate.Laminate`)."""
+        raise NotImplementedError
+
+    def capacitances(self) -> Dict[str, object]:
+        """{'free': (F, how), 'blocked': (F, how)}: the free capacitance the signal terminal
+        sees and the dielectric (blocked) term of the current."""
+        raise NotImplementedError
+
+    def warn_fields(self) -> None:
+        """Warn (:class:`mjeap.model.laminate.FieldWarning`) of each layer the voltage range
+        drives past its material's recommended field or coercive field, naming the layer."""
+        import warnings
+        from ..model.laminate import FieldWarning
+        act = self.scene.actuator
+        for text in self.laminate().field_warnings(self.voltage_range()):
+            warnings.warn(f"{act.source_file or act.id}: {text}", FieldWarning, stacklevel=3)
+
+
+@register_drive
+class PiezoBimorphDrive(LinearPiezo):
+    name = "piezo-bimorph"
+    actuators = ("pzt-hamr-large", "pzt-hamr-small", "pzt-robobee")
+    model_used = "unipolar simultaneous drive, Wood/Jafferis effective stress"
+    #: a core with a piezo layer of equal thickness either side (:meth:`stack_reason`);
+    #: the catalog bimorphs' parameters are in their actuator files
+    ROLES = {"piezo": 2, "core": 1}
+    GENERIC_PARAMETERS = _params(32.2)
+    RANGES = {"bias": (0.0, 200.0 + 1e-9), "f31": (0.0, np.inf), "capacitance": (0.0, np.inf),
+              "resistance": (0.0, np.inf)}
+
+    def __init__(self, scene, **params):
+        super().__init__(scene, **params)
+        act = scene.actuator
+        self.t_p, self.t_cf = self.stack(act)
+        w = scene.layout.hinge_width
+        # N m / V per hinge (module text); under plane strain the plates' stress per field
+        # is f31 / (1 - nu) (mjeap.model.laminate)
+        self._couple(self._f31() * w * (self.t_p + self.t_cf), 0.5 * float(self.params["bias"]),
+                     capacitance=self.params["capacitance"])
+        self.warn_fields()
+
+    def _plane_strain_factor(self) -> float:
+        """1, or 1 / (1 - nu_p) where the section is in plane strain (mjeap.model.laminate)."""
+        act = self.scene.actuator
+        if not act.section_at(0.0).plane_strain:
+            return 1.0
+        return 1.0 / (1.0 - act.layers[[l.role for l in act.layers].index("piezo")].poisson_ratio)
+
+    @staticmethod
+    def stack(actuator):
+        """(t_p, t_cf) (m): a piezo layer's and the core's thickness of a symmetric bimorph."""
+        roles = [l.role for l in actuator.layers]
+        return actuator.layers[roles.index("piezo")].thickness, actuator.layers[roles.index("core")].thickness
+
+    @classmethod
+    def stack_reason(cls, actuator):
+        """The bimorph's stack: exactly one 'core' layer with one 'piezo' layer of equal
+        thickness either side of it (the moment per volt and the closed forms assume it)."""
+        why = super().stack_reason(actuator)
+        if why is not None:
+            return why
+        roles = [l.role for l in actuator.layers]
+        core = [i for i, r in enumerate(roles) if r == "core"]
+        piezo = [i for i, r in enumerate(roles) if r == "piezo"]
+        layers = ", ".join(f"{l.name} ({l.role or 'no role'})" for l in actuator.layers)
+        if len(core) != 1 or len(piezo) != 2 or not piezo[0] < core[0] < piezo[1]:
+            return (f"it needs one 'core' layer between two 'piezo' layers; {actuator.id} has {layers} "
+                    "(drive = \"piezo\" takes any stack)")
+        t1, t2 = (actuator.layers[i].thickness for i in piezo)
+        if abs(t1 - t2) > 1e-9 * max(t1, t2):
+            return (f"its two 'piezo' layers must be equally thick (a symmetric bimorph); they are {t1:g} and {t2:g} m "
+                    "(drive = \"piezo\" takes unequal plates)")
+        return None
+
+    def voltage_range(self):
+        return (0.0, float(self.params["bias"]))
+
+    def resistive_current(self, v: float) -> float:
+        """(2 V_sig - V_bias) / (2 R), eq. (1)."""
+        return (2 * v - self.params["bias"]) / (2 * self.params["resistance"])
+
+    def laminate(self):
+        """The bimorph as a laminate of the general drive's kind: each plate's d31 the
+        equivalent -f31 / Y_p (its stress per field f31), the bottom plate on the signal
+        (V_sig), the top one on the complement (V_bias - V_sig), both poled up; no
+        permittivity (the file gives a capacitance instead)."""
+        from ..model.laminate import Laminate, PiezoLayer
+        if getattr(self, "_laminate", None) is None:
+            act = self.scene.actuator
+            idx = [i for i, l in enumerate(act.layers) if l.role == "piezo"]
+            src = {"d31": "equivalent: -f31 / youngs_modulus (piezo-bimorph's effective stress per field)"}
+            layers = [PiezoLayer(i, act.layers[i].name, -self.params["f31"] / act.layers[i].youngs_modulus, None,
+                                 "signal" if k == 0 else "complement", "up", src, act.layers[i].material_key)
+                      for k, i in enumerate(idx)]
+            self._laminate = Laminate(act, layers, self.params["bias"])
+        return self._laminate
+
+    def capacitances(self):
+        """Free: the model's low-frequency charge per volt C + Gamma^2 int dx / EI (the file
+        has no permittivity); blocked: C, the dielectric term of the current."""
+        c = float(self.params["capacitance"])
+        return {"free": (c + self.laminate().bending_charge_per_volt(),
+                         "model's low-frequency charge per volt, C + Gamma^2 int dx/EI (no permittivity in the file)"),
+                "blocked": (c, "the capacitance parameter: the dielectric (blocked) term of the current")}
 
     # ---- Wood / Jafferis closed forms (mjeap.model.analytical), at this drive's V_eff -------------
     def bending_stiffness_per_width(self) -> float:
@@ -226,16 +317,20 @@ class PiezoBimorphDrive(OpenLoop, NativeForm, Drive):
         """Free deflection (m) at the tip block's end for V_eff = V_sig - V_bias/2 (V): the
         Wood/Jafferis closed form with its plate-voltage difference V = 2 V_eff."""
         L, _, _, lr = self._closed_form_geometry()
-        return an.bimorph_free_deflection(self.params["f31"], 2.0 * v_eff, self.t_p, self.t_cf, L, lr,
+        return an.bimorph_free_deflection(self._f31(), 2.0 * v_eff, self.t_p, self.t_cf, L, lr,
                                           self.bending_stiffness_per_width())
 
     def blocked_force(self, v_eff: float) -> float:
         """Blocked force (N) at the tip block's end for V_eff (V): the Wood/Jafferis closed
         form with V = 2 V_eff and the trapezoid's geometry factor G_F."""
         L, wn, wr, lr = self._closed_form_geometry()
-        return an.bimorph_blocked_force(self.params["f31"], 2.0 * v_eff, self.t_p, self.t_cf, L, wn, wr, lr)
+        return an.bimorph_blocked_force(self._f31(), 2.0 * v_eff, self.t_p, self.t_cf, L, wn, wr, lr)
 
     def reference_curvature(self, t, v, initial_curvature=0.0):
         """Quasi-static uniform curvature of the free bimorph, M / (D w)."""
-        return self.params["f31"] * (self.t_p + self.t_cf) * (np.asarray(v) - 0.5 * self.params["bias"]) / \
+        return self._f31() * (self.t_p + self.t_cf) * (np.asarray(v) - 0.5 * self.params["bias"]) / \
             self.bending_stiffness_per_width()
+
+    def _f31(self) -> float:
+        """The plates' stress per field (Pa m/V): f31, over (1 - nu_p) under plane strain."""
+        return self.params["f31"] * self._plane_strain_factor()

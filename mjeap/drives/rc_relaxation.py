@@ -1,4 +1,4 @@
-"""Ionic actuator: RC charging and back-relaxation (Dadras 2021, seed 000, eqs. 1-8).
+"""Ionic actuator: RC charging and back-relaxation (Dadras 2021, Dadras et al. 2021, eqs. 1-8).
 
 Identified whole-actuator model (eq. 8), K curvature (1/m), V volts:
 
@@ -28,7 +28,7 @@ from ..model.analytical import DadrasModel
 from ..errors import ParameterError
 from .base import Drive, NativeForm, register_drive, zoh_first_order
 
-_SRC = "Dadras et al. 2021 (seed 000), eq. 8 (identified from a 3 V step)"
+_SRC = "Dadras et al. 2021, eq. 8 (identified from a 3 V step)"
 _EQ8 = DadrasModel()      # the identified numbers live there, once
 
 
@@ -37,7 +37,7 @@ class RCRelaxationDrive(NativeForm, Drive):
     name = "rc-relaxation"
     actuators = ("pedot-micro",)
     model_used = "lumped RC + standard-linear-solid back-relaxation"
-    #: the eq. (8) parameters and their units; seed 000's identified values are in
+    #: the eq. (8) parameters and their units; Dadras et al. 2021's identified values are in
     #: pedot-micro's actuator file (mjeap/model/actuators/pedot-micro.toml). No generic
     #: default: an actuator of one's own gives its own (identify them: mjeap identify step)
     UNITS = {"gain": "1/(m s)", "zero": "1/s", "pole_mechanical": "1/s", "pole_electrical": "1/s", "capacitance": "F"}
@@ -74,7 +74,7 @@ class RCRelaxationDrive(NativeForm, Drive):
     def reset(self, initial_curvature: float = 0.0) -> None:
         """Start at rest at the scene's current shape: the relaxation state holds it (zero
         elastic moment beyond what gravity needs), so a bent start decays on the mechanical
-        pole alone, as the zero-input term of seed 000's eq. (7)."""
+        pole alone, as the zero-input term of Dadras et al. 2021's eq. (7)."""
         sc = self.part
         # equilibrium at rest: k (theta - r) = gravity moment on each hinge
         self._r[:] = sc.hinge_angles() - sc.gravity_moments() / sc.hinge_stiffness()

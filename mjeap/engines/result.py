@@ -28,7 +28,7 @@ class RolloutResult:
     voltage: np.ndarray              # (n,) V
     tip_position: np.ndarray         # (n, 3) m
     tip_angle: np.ndarray            # (n,) rad
-    tip_curvature: np.ndarray        # (n,) 1/m, arc through clamp and tip (seed 000)
+    tip_curvature: np.ndarray        # (n,) 1/m, arc through clamp and tip (Dadras et al. 2021)
     centreline: np.ndarray           # (n, N + 2, 3) m
     payload_position: Optional[np.ndarray]
     signals: Dict[str, np.ndarray]   # drive quantities, 'name (unit)'

@@ -5,7 +5,7 @@ When it applies (:func:`why_not` says why not otherwise):
 * the drive is open-loop: its moments follow from the voltage alone and it leaves the
   model unchanged (:meth:`Drive.closed_loop_reason` is None): the piezo bimorph, the
   blocking-force drive without a stiffness table, the electrostrictive drive without field
-  stiffening. Seed 000's rc-relaxation drive is not: its back-relaxation acts on the
+  stiffening. Dadras et al. 2021's rc-relaxation drive is not: its back-relaxation acts on the
   beam's own moments, a feedback on the hinge angles;
 * no controller (its voltage depends on the state) and no tip load set on the scene.
 
@@ -120,7 +120,7 @@ _SPARES: "weakref.WeakKeyDictionary" = weakref.WeakKeyDictionary()
 def spare_datas(owner, model) -> list:
     """The list of spare MjData of ``model`` kept for ``owner`` (the scene or native model
     that holds the model, so they live and die together): :func:`roll` borrows from it and
-    gives back (a new MjData of the native seed 000 model costs ~0.35 ms, a reset 3 us)."""
+    gives back (a new MjData of the native Dadras et al. 2021 model costs ~0.35 ms, a reset 3 us)."""
     held = _SPARES.get(owner)
     if held is None or held[0] is not model:        # a recompiled model: a fresh list
         held = _SPARES[owner] = (model, [])

@@ -26,7 +26,7 @@ does not implement (its own ``put_model`` checks, named).
 Steps go in Warp graphs (CUDA graphs, or Warp's recorded CPU graphs) of a sample interval
 each: the ctrl of those steps is written to one device buffer, the graph replays them, and
 the state comes back once per sample. Kernels compile once per machine into Warp's kernel
-cache (``WARP_CACHE_PATH``; ~50 s on 2 CPU cores for the native seed 000 model).
+cache (``WARP_CACHE_PATH``; ~50 s on 2 CPU cores for the native Dadras et al. 2021 model).
 """
 from __future__ import annotations
 
@@ -126,7 +126,7 @@ def _smooth_step(m, d) -> None:
     constraint solver: position, velocity, actuation, the smooth forces, then the implicit
     update with the smooth forces as its right-hand side (M qacc = qfrc_smooth exactly, no
     constraint force). Why: with no rows the Newton solver still factors the mass matrix
-    alone, whose condition number reaches 4.7e7 on seed 000's standing beam with its
+    alone, whose condition number reaches 4.7e7 on Dadras et al. 2021's standing beam with its
     12.6 mg payload (363 times a link's mass), beyond float32 (1 / eps = 1.7e7): the factor went
     NaN at step 1215 of the 1.333 V run. The implicit update factors M + h D (condition
     ~100 there) and never needs M alone. Sensors are not evaluated (none is read back)."""

@@ -57,7 +57,7 @@ def make_environment(actuator: str = "pedot-micro", reference: Optional[Callable
                      time_limit: float = 20.0, seed=None, drive: Optional[str] = None, drive_params=None,
                      reward_margin: float = 5.0, segments: int = 20, backend: str = "auto") -> dm_env.Environment:
     """A dm_env environment tracking ``reference(t)`` (1/m; default: a 0.05 Hz sine of 50
-    1/m, seed 000's closed-loop case) with ``actuator``. The agent acts every
+    1/m, Dadras et al. 2021's closed-loop case) with ``actuator``. The agent acts every
     ``control_interval`` s (rounded to whole MuJoCo steps) for ``time_limit`` s. ``backend``
     (:data:`BACKENDS`): 'dm_control' (``control.Environment``, MuJoCo 3.x; refused naming the
     versions where dm_control's Physics cannot run), 'dm_env' (:class:`TrackingEnvironment`,

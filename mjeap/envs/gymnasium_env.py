@@ -48,7 +48,7 @@ BAD_STATE_WARNINGS = (mujoco.mjtWarning.mjWARN_BADQPOS, mujoco.mjtWarning.mjWARN
 
 
 class CurvatureTrackingEnv(gymnasium.Env):
-    """Track ``reference(t)`` (1/m; default a 0.05 Hz sine of 50 1/m, seed 000's closed-loop
+    """Track ``reference(t)`` (1/m; default a 0.05 Hz sine of 50 1/m, Dadras et al. 2021's closed-loop
     case) with the tip curvature of ``actuator``.
 
     * Action: the drive's voltage (V), a float32 ``Box`` of shape (1,) spanning the drive's

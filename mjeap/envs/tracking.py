@@ -35,7 +35,7 @@ VALUE_AT_MARGIN = 0.1
 
 
 def default_reference(t):
-    """Seed 000's closed-loop reference: a 0.05 Hz sine of 50 1/m at ``t`` s."""
+    """Dadras et al. 2021's closed-loop reference: a 0.05 Hz sine of 50 1/m at ``t`` s."""
     return 50.0 * np.sin(2 * np.pi * 0.05 * t)
 
 

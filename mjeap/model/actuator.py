@@ -36,6 +36,15 @@ class Layer:
     role: str = ""
     #: the materials library entry (mjeap.model.materials) it was made from, if any
     material_key: Optional[str] = None
+    #: a piezo layer's own datasheet constants (None: its material's, mjeap.model.laminate):
+    #: d31 (m/V) and the relative permittivity eps33^T / eps0
+    d31: Optional[float] = None
+    relative_permittivity: Optional[float] = None
+    #: which voltage a piezo layer sees: 'signal' (the drive's V) or 'complement' (bias - V);
+    #: None: 'signal'
+    electrode: Optional[str] = None
+    #: a piezo layer's poling, 'up' or 'down' (flips the sign of its free strain); None: 'up'
+    poling: Optional[str] = None
 
     def provenance(self, field_name: str) -> str:
         return self.sources.get(field_name, self.source)
@@ -149,6 +158,11 @@ class Actuator:
     def total_mass(self) -> float:
         """Mass of the free length (kg), without the tip extension."""
         return self.mass.value if self.mass is not None else self._layered_mass()
+
+    def actuator_mass(self) -> float:
+        """The actuator's mass (kg): its free length and its rigid tip block (extension and
+        residual mass). The one mass mjeap reports (the ``mass`` metric, ``mjeap show``)."""
+        return self.total_mass() + self.planform.tip_block_mass
 
 
 def validate_actuator(act: Actuator) -> Actuator:

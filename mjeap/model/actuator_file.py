@@ -86,7 +86,10 @@ TOP_KEYS = ("id", "title", "document", "drive", "damping_ratio", "voltage_range"
 PLANFORM_KEYS = ("length", "base_width", "tip_width", "extension_length", "extension_mass", "residual_tip_mass",
                  "source", "extension_source", "residual_source")
 LAYER_KEYS = ("name", "role", "material", "description", "thickness", "width", "youngs_modulus", "density",
-              "poisson_ratio", "source", "sources")
+              "poisson_ratio", "source", "sources", *("d31", "e31", "relative_permittivity", "electrode", "poling"))
+#: the keys only a piezo layer (role = "piezo") takes, and the choices of the two texts
+PIEZO_KEYS = ("d31", "e31", "relative_permittivity", "electrode", "poling")
+ELECTRODES, POLINGS = ("signal", "complement"), ("up", "down")
 _ID = re.compile(r"[A-Za-z0-9_-]+")
 _UNITS = {"length": "m", "base_width": "m", "tip_width": "m", "extension_length": "m", "extension_mass": "kg",
           "residual_tip_mass": "kg", "thickness": "m", "width": "m", "youngs_modulus": "Pa", "density": "kg/m^3",
@@ -230,12 +233,16 @@ def read_actuator(path):
             raise r.error(pre + "sources", sources, "a table of texts: field = \"source\"")
         if m is not None:       # what the layer takes from the material carries its source
             sources = {**{k: f"material {m.name}: {m.property(k).source}" for k in values if k not in ld}, **sources}
+        piezo = _piezo_keys(r, ld, pre, values["youngs_modulus"], m)
+        if "e31" in ld and "d31" not in ld and "d31" not in sources:   # d31 carries e31's source
+            sources = {**sources, "d31": f"e31 = {ld['e31']} / youngs_modulus; e31: "
+                       + sources.get("e31", r.text(ld, "source", pre, default="not given"))}
         layers.append(Layer(name=name, material=r.text(ld, "description", pre, default=m.title if m else name),
                             thickness=r.number(ld, "thickness", "m", pre, required=True),
                             width=r.number(ld, "width", "m", pre, default=None), source=r.text(
                                 ld, "source", pre, default=(f"material {m.name}" if m else "not given")),
                             sources=dict(sources), role=r.text(ld, "role", pre, default=""),
-                            material_key=m.name if m else None, **values))
+                            material_key=m.name if m else None, **values, **piezo))
     # overrides
     overrides = {}
     for k in ("flexural_rigidity", "mass"):
@@ -286,6 +293,44 @@ def read_actuator(path):
         raise r.error("layers", [f"{l.name} ({l.role or 'no role'})" for l in act.layers],
                       f"a layer stack the {drive} drive can take", why)
     return act
+
+
+def _piezo_keys(r: _Reader, ld: dict, pre: str, youngs_modulus: float, material) -> dict:
+    """A layer's piezo keys (:data:`PIEZO_KEYS`, a role = "piezo" layer only) as Layer
+    fields: d31 (m/V) from ``d31`` or from ``e31`` (C/m^2) / the layer's Young's modulus (the
+    beam's uniaxial-stress model: e31 = d31 Y), both given only where they agree;
+    ``relative_permittivity`` (> 0); ``electrode`` and ``poling`` among their choices."""
+    given = [k for k in PIEZO_KEYS if k in ld]
+    if not given:
+        return {}
+    if ld.get("role") != "piezo":
+        raise r.error(pre + given[0], ld[given[0]], "a piezo constant only on a layer with role = \"piezo\"")
+    out = {}
+    d31 = None if "d31" not in ld else to_si(ld["d31"], "m/V", r.where(pre + "d31"))
+    if "e31" in ld:
+        from_e = to_si(ld["e31"], "C/m^2", r.where(pre + "e31")) / youngs_modulus
+        if d31 is not None and not math.isclose(d31, from_e, rel_tol=1e-6):
+            raise r.error(pre + "e31", ld["e31"], f"e31 = d31 x youngs_modulus = {d31 * youngs_modulus:.6g} C/m^2 "
+                          "(this beam's uniaxial-stress model), or only one of d31 and e31",
+                          f"d31 = {d31:g} m/V and e31 disagree")
+        d31 = from_e if d31 is None else d31
+    for k, v in (("d31", d31),):
+        if v is not None:
+            if not (math.isfinite(v) and v != 0):
+                raise r.error(pre + k, ld.get(k, ld.get("e31")), "a finite, non-zero piezoelectric constant")
+            mat.check_value(material, "d31", v, r.where(pre + ("d31" if "d31" in ld else "e31 / youngs_modulus")))
+            out["d31"] = v
+    if "relative_permittivity" in ld:
+        eps = r.number(ld, "relative_permittivity", "-", pre)
+        mat.check_value(material, "relative_permittivity", eps, r.where(pre + "relative_permittivity"))
+        out["relative_permittivity"] = eps
+    for k, choices in (("electrode", ELECTRODES), ("poling", POLINGS)):
+        if k in ld:
+            v = r.text(ld, k, pre)
+            if v not in choices:
+                raise r.error(pre + k, v, " or ".join(f'"{c}"' for c in choices))
+            out[k] = v
+    return out
 
 
 def _unknown(where: str, kind: str, name: str, known) -> UnknownNameError:
@@ -409,6 +454,8 @@ def actuator_toml(act) -> str:
             out.append(f"width = {_fmt(l.width)}")
         out += [f"youngs_modulus = {_fmt(l.youngs_modulus)}", f"density = {_fmt(l.density)}",
                 f"poisson_ratio = {_fmt(l.poisson_ratio)}", f"source = {_fmt(l.source)}"]
+        out += [f"{k} = {_fmt(getattr(l, k))}" for k in ("d31", "relative_permittivity", "electrode", "poling")
+                if getattr(l, k) is not None]
         if l.sources:
             out.append(f"sources = {_inline(l.sources)}")
     out += ["", "[drive]", f"name = {_fmt(drive)}"]

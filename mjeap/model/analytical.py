@@ -119,7 +119,7 @@ def arc_tip_moment(M: float, L: float, EI: float) -> Tuple[float, float, float]:
 def arc_curvature(x: float, y: float) -> float:
     """Curvature (1/m) of the circular arc tangent to the beam axis at the clamp (origin,
     axis along x) that passes through the tip (x, y): kappa = 2 y / (x^2 + y^2).
-    This is how seed 000 measures the curvature of the whole actuator."""
+    This is how Dadras et al. 2021 measures the curvature of the whole actuator."""
     return 2.0 * y / (x * x + y * y)
 
 
@@ -266,15 +266,15 @@ def critical_load_with_arm(L: float, EI: float, arm: float = 0.0) -> float:
     return EI * (kL / L) ** 2
 
 
-# ---------------------------------------------------------------- seed 000's loaded-actuator model
-#: Table I of seed 000: region upper bounds of kappa*l_e (rad), feedback and input coefficients
+# ---------------------------------------------------------------- Dadras et al. 2021's loaded-actuator model
+#: Table I of Dadras et al. 2021: region upper bounds of kappa*l_e (rad), feedback and input coefficients
 DADRAS_REGIONS = ((-1.05, 0.24, -0.60), (-0.55, 0.70, -0.14), (0.55, 1.00, 0.0), (1.05, 0.70, 0.14),
                   (np.inf, 0.24, 0.60))
 
 
 @dataclass(frozen=True)
 class DadrasModel:
-    """Seed 000's lumped model (SI): electrical block (k_tf / g_m) / (s + a) from volts to an
+    """Dadras et al. 2021's lumped model (SI): electrical block (k_tf / g_m) / (s + a) from volts to an
     equivalent moment (N m), mechanical block g_m (s + z) / (s + p) from moment to curvature
     (1/m), with g_m = 1/EI = 4.86e7 1/(N m^2); together eq. (8),
     K/V = 63 (s + 0.52) / ((s + 0.3)(s + 1.8)). A payload closes a positive feedback loop on
@@ -415,10 +415,10 @@ def first_frequency_variable(L: float, EI, mass_per_length, guess: float, tip_ma
     return float(np.sqrt(sol.p[0] * EI0 / (m0 * L**4)) / (2 * np.pi))
 
 
-# ------------------------------------------- PZT bimorph closed forms (seed 003's actuators)
+# ------------------------------------------- PZT bimorph closed forms (Jayaram et al. 2018's actuators)
 # Transcribed, with the published variables, from Jafferis et al. 2015 (Smart Mater. Struct. 24
 # 065023) as Harvard's own HAMR actuator model implements them (HarvardAgileRoboticsLab/drake,
-# examples/HAMR-URDF/dev/Actuator/PZTBender2.m: ``df``, ``GF``, ``Ft``/``Fb``), and seed 003's
+# examples/HAMR-URDF/dev/Actuator/PZTBender2.m: ``df``, ``GF``, ``Ft``/``Fb``), and Jayaram et al. 2018's
 # eq. (13). Independent of mjeap's drive and section code: they are the checks of those.
 #
 # V is the closed form's voltage, the difference of the two plates' voltages: PZTBender2 sets
@@ -466,7 +466,7 @@ def bimorph_blocked_force(f31: float, V: float, t_p: float, t_cf: float, L: floa
 
 
 def bimorph_motional_current(f31: float, area: float, strain_rate):
-    """Seed 003 eq. (13): the motional current of a free bimorph, I = 2 A f31 d(eps_1)/dt (A),
+    """Jayaram et al. 2018 eq. (13): the motional current of a free bimorph, I = 2 A f31 d(eps_1)/dt (A),
     A the electrode area of one plate (m^2), eps_1 the bending strain of one plate (its
     mean over the plate; the two plates' strains are opposite and their currents add)."""
     return 2.0 * area * f31 * np.asarray(strain_rate)

@@ -17,10 +17,10 @@ from ..errors import ParameterError, UnknownNameError
 from .actuator import Actuator, Layer, Planform, Sourced, validate_actuator  # noqa: F401  (the catalog's types)
 from .actuator_file import is_actuator_file, read_actuator
 
-SEED_000 = "Dadras et al. 2021, IEEE JMEMS 30(3) (seed 000)"
-SEED_001 = "Mutlu, Alici, Li 2013, IEEE/ASME AIM (seed 001)"
-SEED_002 = "Metello 2020, MSc thesis (seed 002)"
-SEED_003 = "Jayaram et al. 2018, Smart Mater. Struct. 27 065028 (seed 003)"
+SEED_000 = "Dadras et al. 2021, IEEE JMEMS 30(3)"
+SEED_001 = "Mutlu, Alici, Li 2013, IEEE/ASME AIM"
+SEED_002 = "Metello 2020, MSc thesis"
+SEED_003 = "Jayaram et al. 2018, Smart Mater. Struct. 27 065028"
 
 
 # =========================================================================================

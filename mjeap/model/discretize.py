@@ -21,7 +21,7 @@ from ..caching import BoundedCache
 from ..errors import ParameterError, check_positive, check_range
 
 #: density used for a payload whose size is not given: sintered NdFeB, as the magnets
-#: of seed 000 (literature default, 7.5 g/cm^3)
+#: of Dadras et al. 2021 (literature default, 7.5 g/cm^3)
 PAYLOAD_DENSITY = 7500.0
 #: how far past the tip a payload centre may sit, as a fraction of the beam length
 MAX_PAYLOAD_OVERHANG = 0.25
@@ -30,7 +30,7 @@ MAX_PAYLOAD_OVERHANG = 0.25
 @dataclass(frozen=True)
 class Payload:
     """A rigid tip payload: ``mass`` (kg) centred ``position`` (m) from the clamp along the
-    beam (seed 000's effective length l_e; it may sit on a rigid tip extension and overhang
+    beam (Dadras et al. 2021's effective length l_e; it may sit on a rigid tip extension and overhang
     the tip by up to 25 % of L, a magnet stuck on the tip). Its rotary inertia about its
     centre (kg m^2): ``inertia`` if given (0 is a point mass, :meth:`point`), else that of a
     solid sphere of ``radius`` (m), by default an NdFeB sphere of the same mass."""
@@ -237,7 +237,7 @@ def clamp_rotation(orientation) -> np.ndarray:
     """World rotation of the clamp frame (columns: beam axis x, deflection y, hinge axis z).
 
     horizontal: bending plane horizontal (hinge axis vertical), gravity out of the plane;
-    up: beam points against gravity (seed 000's inverted payload case);
+    up: beam points against gravity (Dadras et al. 2021's inverted payload case);
     down: beam hangs along gravity. A 3 x 3 rotation matrix is taken as it is (an
     actuator attached to a tilted mount, :func:`mjeap.attach`).
     """

@@ -4,7 +4,7 @@
 state; the input linearly interpolated between samples, or held), computed by the same
 exact discretisation (``scipy.signal.cont2discrete``, first- or zero-order hold) but run
 by ``scipy.signal.lfilter`` in C instead of scipy's per-sample Python loop: a 5,000-sample
-response in ~1 ms instead of ~15-20 ms (every seed 000 rollout computes one; equal to
+response in ~1 ms instead of ~15-20 ms (every Dadras et al. 2021 rollout computes one; equal to
 scipy's to ~1e-11 of the swing, tests/model/test_lti.py). A grid that
 is not uniform goes to ``scipy.signal.lsim`` itself.
 """

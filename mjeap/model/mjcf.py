@@ -2,7 +2,7 @@
 
 Two representations sit behind one interface, :class:`BeamBuilder`:
 
-* ``hinge``: a planar chain of rigid links joined by damped hinge springs (seed 001's
+* ``hinge``: a planar chain of rigid links joined by damped hinge springs (Mutlu et al. 2013's
   16-link model, any N), built with MjSpec.
 * ``cable``: MuJoCo's ``composite type="cable"`` with the ``mujoco.elasticity.cable``
   plugin (3D: bending in both directions and twist). The composite is expanded by MuJoCo's

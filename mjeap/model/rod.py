@@ -76,7 +76,7 @@ Refused on the rod, each with its reason (:class:`RodBuilder`):
   angles are functions of the vertex positions. A native form would need (a) the moment
   as a transmission, e.g. a ``site`` actuator with gear (0 0 0 0 0 1) on the tip frame for a
   moment that is the same at every vertex (a uniform internal moment is a couple on the last
-  edge), and (b) per-vertex angles for anything per hinge: seed 000's back-relaxation
+  edge), and (b) per-vertex angles for anything per hinge: Dadras et al. 2021's back-relaxation
   (a Maxwell arm per hinge, a fixed tendon theta_j - r_j) and the piezo's width-weighted
   moments. MuJoCo 4.0's flex offers no per-vertex bending coordinate.
 * ``engine="threaded"``: its moments are forces along the present edge normals, not fixed

@@ -1,7 +1,7 @@
 """Runs at a stated accuracy: the cheapest hinge-chain model (segments, integrator, timestep)
 whose error stays below a target, and an a-posteriori estimate of the error it made.
 
-The quantity: the tip curvature kappa (1/m, the arc through clamp and tip, as seed 000
+The quantity: the tip curvature kappa (1/m, the arc through clamp and tip, as Dadras et al. 2021
 measures it). A run's error is max over its samples of |kappa - kappa_converged| divided by
 the swing (peak to peak) of kappa over the run: ``accuracy=1e-3`` asks for 0.1 % of the swing.
 
@@ -17,13 +17,13 @@ A priori, the error of N segments stepped at h is modelled as
   the geometry (a chord of a bent segment is shorter than its arc: (kappa L / N)^2 / 24) and
   the discretised gravity and payload loads.
 * b h: the semi-implicit (and under 'discrete' backward) Euler step with the drive's moment
-  held over it (zero-order hold) is first order in h (measured on seed 000-002's beams; the
+  held over it (zero-order hold) is first order in h (measured on Dadras et al. 2021-002's beams; the
   beam follows its drive about a step late). ``b`` is measured by a third pilot of 6
   segments at h / 2: its difference from the first is b h / 2 (the segments' error
   cancelling).
 
 The two are combined in quadrature, not added: the chord error is largest where the beam is
-most bent, the lag where it moves fastest, at different instants (on seed 000's heaviest run
+most bent, the lag where it moves fastest, at different instants (on Dadras et al. 2021's heaviest run
 the sum overstates the default model's error 1.9 x, the root sum of squares 1.3 x).
 The cheapest (N, h) with e(N, h) <= target / SAFETY is taken, a step costing about
 COST_PER_STEP = c0 + c1 N (measured, ``scripts/bench.py``): under ``implicitfast`` where 4 h
@@ -95,7 +95,7 @@ COMPANION_STEPS = (2, 4)
 #: refinement catches the rest)
 SAFETY = 1.5
 MAX_REFINEMENTS = 2
-#: cost of a native step, c0 + c1 N (us, this 2-core machine, seed 000's beam; only the
+#: cost of a native step, c0 + c1 N (us, this 2-core machine, Dadras et al. 2021's beam; only the
 #: ratio matters) and the extra of 'discrete' over 'implicitfast' per step
 COST_PER_STEP = (3.0, 0.6)
 DISCRETE_COST = 1.15

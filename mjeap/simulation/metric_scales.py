@@ -68,7 +68,7 @@ def peak_to_peak(time, kappa, period) -> float:
 
 def returns_margin(time, kappa, period) -> float:
     """min(max kappa, -min kappa) over the last drive period (1/m): > 0 where the tip
-    curvature changes sign there (seed 000's criterion), its distance from deciding else."""
+    curvature changes sign there (Dadras et al. 2021's criterion), its distance from deciding else."""
     k = kappa[last_period(time, period)]
     return float(min(k.max(), -k.min()))
 

@@ -211,7 +211,7 @@ class ActuatorPart:
     def set_hinge_parameters(self, stiffness=None, damping=None) -> None:
         """Set every hinge's bending stiffness (N m / rad) and/or viscous damping (N m s / rad),
         scalars or one value per hinge, replacing the catalog beam's (the joint-level view of
-        seed 001's model; see :mod:`mjeap.analysis.identify`). Hinge chain only. The timestep is not
+        Mutlu et al. 2013's model; see :mod:`mjeap.analysis.identify`). Hinge chain only. The timestep is not
         re-chosen: a stiffer, less damped chain than the model was built for can diverge
         (the step then raises :class:`DivergenceError`)."""
         if not self.builder.per_hinge_parameters:
@@ -337,7 +337,7 @@ class ActuatorPart:
         return float(self.in_plane_angle(self._data.xmat[self.tip_body_id]))
 
     def tip_curvature(self) -> float:
-        """Curvature (1/m) of the arc through clamp and tip, tangent at the clamp (seed 000)."""
+        """Curvature (1/m) of the arc through clamp and tip, tangent at the clamp (Dadras et al. 2021)."""
         p = self.tip_position()
         return analytical.arc_curvature(p[0], p[1])
 

@@ -84,7 +84,7 @@ def warn_heavy_payload(mass: float, beam_mass: float, what: str = "payload", sta
         warnings.warn(f"{what} {mass:.4g} kg is {mass / beam_mass:.3g} x the beam's mass ({beam_mass:.3g} kg): "
                       "check its unit (SI is kg; '12.6mg' for milligrams)", stacklevel=stacklevel)
 #: tip angle (rad) of the uniform arc at which the cable's stability limit is checked
-#: besides the straight beam; seed 000's actuator bends to about 1.8 rad
+#: besides the straight beam; Dadras et al. 2021's actuator bends to about 1.8 rad
 DEFAULT_MAX_BEND = 2.0
 
 
@@ -365,7 +365,7 @@ class Scene:
         # beta phi_1' D_1 phi_1 = 2 zeta w1 with D_1 the pattern per unit beta, so beta is
         # taken from that: with gravity's geometric stiffness in the frequency but not in
         # the damping, 2 zeta / w1 would give zeta (w_el / w1)^2 (0.16 standing up, 0.03
-        # hanging with 100 mg on seed 000's beam).
+        # hanging with 100 mg on Dadras et al. 2021's beam).
         pattern = np.clip(np.diag(lin.K_elastic), 0.0, None)
         k1 = float(phi[:, 0] @ (pattern * phi[:, 0]))
         beta = 2 * zeta * w1 / k1
@@ -482,7 +482,7 @@ class Scene:
 
     def reset(self, curvature: float = 0.0) -> None:
         """Reset to rest; ``curvature`` (1/m) starts the beam as a uniform arc of that
-        curvature (seed 000 starts each experiment from a measured curvature)."""
+        curvature (Dadras et al. 2021 starts each experiment from a measured curvature)."""
         mujoco.mj_resetData(self.model, self.data)
         self.part.after_data_reset()         # mj_resetData clears qfrc/xfrc_applied; tip loads persist
         self.part.set_bending_stiffness_scale(1.0)

@@ -347,7 +347,7 @@ def _exclude_own_contacts(spec: mujoco.MjSpec, handles, prefix: str) -> None:
 def add_transmission(spec: mujoco.MjSpec, actuator: AttachedActuator, joint: str, ratio: float) -> None:
     """Couple the host's hinge ``joint`` to an attached ``actuator``'s tip: joint angle (rad)
     = ``ratio`` (rad/m, signed) x the tip's deflection linearised in the hinge angles (m),
-    the small-motion transmission seed 003 states (RoboBee T_eff, HAMR T / leg length). A
+    the small-motion transmission Jayaram et al. 2018 states (RoboBee T_eff, HAMR T / leg length). A
     fixed tendon '<prefix>tip_deflection' sums the actuator's hinges with coefficients
     x_tip - x_j, a tendon '<prefix>transmission' reads the joint, and a tendon equality
     holds one at ``ratio`` times the other."""

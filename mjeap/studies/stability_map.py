@@ -28,7 +28,7 @@ from .sweep import EXECUTORS, grid, read_results, run_sweep
 
 __all__ = ["MAP_BASE", "column_limits", "simulated_edges", "main"]
 
-#: the sweep base of seed 000's map: standing up, payload at l_e, 0.1 Hz square wave, 30 s
+#: the sweep base of Dadras et al. 2021's map: standing up, payload at l_e, 0.1 Hz square wave, 30 s
 #: (three periods)
 MAP_BASE = dict(actuator="pedot-micro", orientation="up", payload_position=6.27e-3, waveform="square",
                 frequency=0.1, duration=30.0)
@@ -57,7 +57,7 @@ def simulated_edges(mass: Sequence[float], amplitude: Sequence[float], returns: 
     return edges
 
 
-MAP_DESCRIPTION = "Stability map of the PEDOT micro trilayer standing up (seed 000): payload mass x drive amplitude."
+MAP_DESCRIPTION = "Stability map of the PEDOT micro trilayer standing up (Dadras et al. 2021): payload mass x drive amplitude."
 
 
 def main(argv=None):
@@ -79,7 +79,7 @@ def main(argv=None):
                          "and timestep chosen per point, steps far beyond the beam's modes where the drive is slow; "
                          "estimates in the estimated_error.METRIC columns (max_stress_proxy is then not reported)")
     ap.add_argument("--periods", type=arg_integer(1, 1000), default=3,
-                    help="drive periods (10 s each) a point runs, the criterion read on the last (seed 000: 3)")
+                    help="drive periods (10 s each) a point runs, the criterion read on the last (Dadras et al. 2021: 3)")
     ap.add_argument("--stop-when-periodic", type=float, default=None, metavar="TOL",
                     help="stop a point once its last drive period repeats the one before within TOL (1e-6 to 0.2, "
                          "of the tip curvature's range and of the length) and its shrinking change still to come "
@@ -111,7 +111,7 @@ def main(argv=None):
     sim_edge = simulated_edges(m, v, ok)
     lines = ["# Stability map: pedot-micro standing up, payload at l_e = 6.27 mm, 0.1 Hz square wave", "",
              f"{len(rows)} points of {a.periods} periods; criterion: tip curvature changes sign in the last period "
-             "(seed 000: the third)" + (f"; stopped once periodic within {a.stop_when_periodic:g} (stopped_early)"
+             "(Dadras et al. 2021: the third)" + (f"; stopped once periodic within {a.stop_when_periodic:g} (stopped_early)"
                                         if a.stop_when_periodic else "") + ".", "",
              "| amplitude (V) | simulated limit (mg) |", "|---|---|"]
     lines += [f"| {amp:.3g} | {edge:.1f} |" for amp, edge in sim_edge.items()]

@@ -1,4 +1,4 @@
-"""Seed 000 (Dadras et al. 2021): the PEDOT:PSS/PEO micro trilayer, unloaded and loaded.
+"""Dadras et al. 2021: the PEDOT:PSS/PEO micro trilayer, unloaded and loaded.
 
 References: the paper's fitted step response (eq. 7) and transfer function (eq. 8, via
 scipy.signal.lsim) as published formulas; its piecewise-linear loaded model (Table I with eqs. 6
@@ -21,7 +21,7 @@ from .core import INDEPENDENT_SOLUTION, PUBLISHED_FORMULA, Experiment, experimen
 
 UP = clamp_rotation("up")
 EQ8 = signal.TransferFunction([63.0, 63.0 * 0.52], np.polymul([1, 0.3], [1, 1.8]))
-PAPER = "Dadras et al. 2021 (seed 000)"
+PAPER = "Dadras et al. 2021"
 #: Table II: payload (kg), l_e (m), kappa(0-) at 2 Vpp and 3 Vpp (1/m)
 TABLE_II = ((3.15e-6, 6.20e-3, -133.0, -132.0), (6.30e-6, 6.70e-3, -156.0, -241.0),
             (12.60e-6, 6.27e-3, -209.0, -303.0))

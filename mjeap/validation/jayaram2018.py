@@ -1,4 +1,4 @@
-"""Seed 003 (Jayaram et al. 2018): PZT-5H bimorphs of HAMR and RoboBee.
+"""Jayaram et al. 2018: PZT-5H bimorphs of HAMR and RoboBee.
 
 References: the tapered-plate eigenproblem (scipy solve_bvp) for the resonance, Table 1 as a
 comparison; the single-mode second-order model built from the Wood/Jafferis free deflection
@@ -16,7 +16,7 @@ from ..simulation.scene import Scene
 from .core import INDEPENDENT_SOLUTION, PUBLISHED_FORMULA, Experiment, experiment
 from .mechanics import free_vibration_frequency
 
-PAPER = "Jayaram et al. 2018 (seed 003)"
+PAPER = "Jayaram et al. 2018"
 TABLE_1 = {"pzt-hamr-large": 1400.0, "pzt-hamr-small": 1750.0, "pzt-robobee": 1020.0}
 
 

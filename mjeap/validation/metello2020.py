@@ -1,8 +1,8 @@
-"""Seed 002 (Metello 2020): the P(VDF-TrFE-CTFE) five-layer unimorphs, as the thesis tests them.
+"""Metello 2020: the P(VDF-TrFE-CTFE) five-layer unimorphs, as the thesis tests them.
 
 References: published formulas for the simulated beam as tolerance checks: the tip stiffness
 3 EI/L^3 (thesis eq. 3.12) and, per unit of the drive's moment M, the blocked force 3/(2L)
-(seed 000 eq. 6) and the free tip displacement L^2/(2 EI) (eq. 3.12 with seed 000 eq. 6). The
+(Dadras et al. 2021 eq. 6) and the free tip displacement L^2/(2 EI) (eq. 3.12 with Dadras et al. 2021 eq. 6). The
 moment M(V) itself (eigenstrain, Q fitted) has no independent reference: it meets the
 measurements only in comparison rows. The thesis's measured tables (4.1-4.4, 4.6, 6.1), its
 beam model and its COMSOL results (5.3) are comparisons, with the disagreement stated. The
@@ -19,7 +19,7 @@ from ..drives.electrostrictive import FIELDS, SLOPES, active_layer, eigenstrain_
 from ..simulation.scene import Scene
 from .core import PUBLISHED_FORMULA, Experiment, experiment
 
-THESIS = "Metello 2020 (seed 002)"
+THESIS = "Metello 2020"
 SAMPLES = ("pvdf-60", "pvdf-60-half", "pvdf-130")
 #: thesis 'Model' slope (N/mm), Tables 4.1-4.3
 MODEL_SLOPE = {"pvdf-60": 5.00e-4, "pvdf-60-half": 2.90e-4, "pvdf-130": 8.60e-4}
@@ -177,7 +177,7 @@ def _driven(ex: Experiment, act_id: str, scene, EI: float, t_a: float, role: str
         blocked.append(-Fb)
         tag = f"{E / 1e6:.2f} MV/m"
         ex.check(f"{act_id} {tag}: blocked force / drive moment M", "1/m", -Fb / M, 1.5 / L,
-                 "Dadras et al. 2021 (seed 000) eq. (6), M = (2/3) l F: the uniform moment M is blocked by "
+                 "Dadras et al. 2021 eq. (6), M = (2/3) l F: the uniform moment M is blocked by "
                  "F = 3 M / (2 L)", tolerance=0.01, kind=PUBLISHED_FORMULA,
                  note=f"M = {M:.4g} N m is the drive's (an input here: this row checks the beam's response to it, "
                       f"not M); tip held at {abs(y_check) / abs(y_free):.1e} of the free deflection")
@@ -185,7 +185,7 @@ def _driven(ex: Experiment, act_id: str, scene, EI: float, t_a: float, role: str
         ex.check(f"{act_id} {tag}: blocked force vs measured (predicted)", "N", -Fb,
                  0.5 * (lo + hi), f"{THESIS} Table 6.1 (range {lo:.3g}-{hi:.3g} N, mid-range shown)")
         ex.check(f"{act_id} {tag}: free tip displacement / drive moment M", "m/(N m)", y_free / M,
-                 L**2 / (2 * EI), f"{THESIS} eq. (3.12) with the tip force W = 3 M / (2 L) of seed 000 eq. (6): "
+                 L**2 / (2 * EI), f"{THESIS} eq. (3.12) with the tip force W = 3 M / (2 L) of Dadras et al. 2021 eq. (6): "
                  "L^2 / (2 EI), small deflection, EI the catalog's", tolerance=0.02, kind=PUBLISHED_FORMULA,
                  note="M is the drive's (an input here); M(V) meets the measurements only in the comparison rows")
         ex.check(f"{act_id} {tag}: free tip displacement vs measured ({role})", "m", y_free,

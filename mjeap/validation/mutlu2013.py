@@ -1,6 +1,6 @@
-"""Seed 001 (Mutlu, Alici, Li 2013): the PPy trilayer as a 16-link compliant chain.
+"""Mutlu, Alici, Li 2013: the PPy trilayer as a 16-link compliant chain.
 
-References: the blocked tip force against the blocking force the drive is given (seed 000
+References: the blocked tip force against the blocking force the drive is given (Dadras et al. 2021
 eq. 6: the uniform moment (2/3) F_B L and the tip force F_B give the same tip deflection), a
 published formula that checks the drive's moment; the continuum beam with the same EI under
 the drive's moment (the exact arc, an independent solution) for the chain's shape. The
@@ -18,7 +18,7 @@ from ..simulation.rollout import rollout
 from ..simulation.scene import Scene
 from .core import INDEPENDENT_SOLUTION, PUBLISHED_FORMULA, Experiment, experiment
 
-PAPER = "Mutlu et al. 2013 (seed 001)"
+PAPER = "Mutlu et al. 2013"
 
 
 def arc_points(s, kappa):
@@ -64,8 +64,8 @@ def chain(quick: bool = False) -> Experiment:
         scene.set_tip_force(0.0)
         F_blocked = F_B - ys[0] * 0.05 * F_B / (ys[1] - ys[0])
         ex.check(f"{v:g} V, settled: blocked tip force", "N", F_blocked, F_B,
-                 "seed 000 eq. (6), M_e = (2/3) l_e F_e: the uniform moment (2/3) F_B L and the tip force F_B give the "
-                 "same tip deflection, so the blocked tip pushes with the blocking force F_B(t, V) that seed 001's "
+                 "Dadras et al. 2021 eq. (6), M_e = (2/3) l_e F_e: the uniform moment (2/3) F_B L and the tip force F_B give the "
+                 "same tip deflection, so the blocked tip pushes with the blocking force F_B(t, V) that Mutlu et al. 2013's "
                  f"model (its eqs. 12-14) is given; here F_1 V (1 - e^(-t/tau)), the catalog's F_1 = {F1 * 1e3:g} mN/V, "
                  f"tau = {tau:g} s (estimates), at t = {duration:g} s", tolerance=0.01, kind=PUBLISHED_FORMULA,
                  note="the tip force that holds the tip at 0, interpolated between two runs; the 16 links (about "
@@ -87,14 +87,14 @@ def chain(quick: bool = False) -> Experiment:
     ex.curve("tip paths", "continuum arc-tip locus", locus[:, 0] * 1e3, locus[:, 1] * 1e3, "tip x (mm)", "tip y (mm)")
     ex.notes.append(
         f"Drive: blocking force {scene.actuator.id} 0.5 mN/V with a 2 s time constant (estimates, see the "
-        "catalog) as a uniform moment (2/3) F_B L at every joint, as seed 001's model reads once its "
+        "catalog) as a uniform moment (2/3) F_B L at every joint, as Mutlu et al. 2013's model reads once its "
         "garbled eqs. 12-14 are made mechanically consistent. Horizontal bending plane (no gravity in it).")
     return ex
 
 
 @experiment("mutlu2013-identify")
 def identify(quick: bool = False) -> Experiment:
-    ex = Experiment("mutlu2013-identify", "Seed 001's identification as a tool: joint stiffness and damping from a noisy tip trajectory")
+    ex = Experiment("mutlu2013-identify", "Mutlu et al. 2013's identification as a tool: joint stiffness and damping from a noisy tip trajectory")
     scene = Scene("ppy-trilayer", segments=16)
     k0, b0 = float(scene.hinge_stiffness()[0]), float(scene.hinge_damping()[0])
     truth = (1.3 * k0, 10.0 * b0)

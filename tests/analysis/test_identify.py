@@ -9,7 +9,7 @@ from mjeap import ParameterError, Scene
 from mjeap.cli import main
 from mjeap.analysis.identify import fit_hinge_parameters, fit_step_response, read_columns, simulate_tip
 
-TRUTH = dict(gain=63.0, zero=0.52, pole_mechanical=0.3, pole_electrical=1.8)   # seed 000, eq. 8
+TRUTH = dict(gain=63.0, zero=0.52, pole_mechanical=0.3, pole_electrical=1.8)   # Dadras et al. 2021, eq. 8
 
 
 def step_data(noise, k0=-174.0, dt=0.01, T=20.0, seed=0):
@@ -56,7 +56,7 @@ def test_step_fit_drive_runs_and_reproduces_the_data():
 
 @pytest.mark.slow
 def test_hinge_fit_recovers_stiffness_and_damping_with_noise():
-    """Seed 001's identification: 1 % noise, truth k = 1.3 k0, b = 10 b0; both within 2 %."""
+    """Mutlu et al. 2013's identification: 1 % noise, truth k = 1.3 k0, b = 10 b0; both within 2 %."""
     s = Scene("ppy-trilayer", segments=16)
     k0, b0 = float(s.hinge_stiffness()[0]), float(s.hinge_damping()[0])
     t = np.arange(0.001, 0.3, 0.001)

@@ -2,12 +2,12 @@
 rollout, mjcf, identify, sweep), attach, the materials library's command, identify writing
 identified.toml, and the example files, against references derived here, not from mjeap:
 
-- seed 000's eq. (8), K/V = g (s + z) / ((s + p)(s + a)): its step response by
+- Dadras et al. 2021's eq. (8), K/V = g (s + z) / ((s + p)(s + a)): its step response by
   scipy.signal.lsim is the "measurement" a step identification starts from and the curve
   the identified file must then simulate;
 - a uniform couple M bends a cantilever into an arc: tip deflection (1 - cos(kappa L)) /
   kappa, kappa = M / EI; the blocking-force drive's couple is (2/3) F_B L with F_B rising as
-  F1 V (1 - exp(-t / tau)) (seed 001's first-order blocking force), slow against the beam's
+  F1 V (1 - exp(-t / tau)) (Mutlu et al. 2013's first-order blocking force), slow against the beam's
   first mode, so that the beam follows quasi-statically: the "measurement" a hinge
   identification starts from, its truth EI given here;
 - the transformed section (Gere & Timoshenko): z_n = sum E_i t_i z_i / sum E_i t_i,
@@ -67,7 +67,7 @@ def test_show_a_file_lists_its_drive_parameters_marking_the_generic_ones(capsys)
     code, out, _ = _run(capsys, "show", BIMORPH)
     assert code == 0 and f"file: {BIMORPH}" in out
     drive = out.split("drive piezo-bimorph")[1].split("derived:")[0]
-    assert re.search(r"^  bias +200 V +seed 003: bias 25-200 V tested$", drive, re.M)
+    assert re.search(r"^  bias +200 V +Jayaram et al. 2018: bias 25-200 V tested$", drive, re.M)
     assert re.search(r"^  capacitance +1\.49e-08 F +pzt-hamr-small's 8 nF scaled", drive, re.M)
     assert re.search(r"^\* resistance +1e\+09 ohm +illustrative", drive, re.M)     # left out: the drive's
     assert "* the drive's generic value: the actuator's file gives none" in drive
@@ -205,7 +205,7 @@ def test_identify_step_writes_the_users_file_with_eq8_and_it_simulates_eq8(tmp_p
     for k, v in EQ8.items():
         value, _, source = act.drive_parameters[k]
         assert value == pytest.approx(v, rel=1e-6), k
-        assert source.startswith(f"identified from {data} (mjeap identify step: seed 000 eqs. 7-8"), source
+        assert source.startswith(f"identified from {data} (mjeap identify step: Dadras et al. 2021 eqs. 7-8"), source
     assert act.drive_parameters["capacitance"] == (2e-3, "", "given on the command line (mjeap identify step --param)")
     assert "blocking_force_per_volt" not in act.drive_parameters      # the old drive's are dropped
     r = rollout(Scene(str(out), segments=8, gravity=False), "step:0.5V", 10.0, progress=False)

@@ -21,7 +21,7 @@ def track(mass, **kw):
 
 @pytest.mark.slow
 def test_tracks_050_hz_sine_with_12_6_mg_inverted_within_5_percent():
-    """Seed 000's heaviest payload standing up, 50 1/m at 0.05 Hz: RMS error of the second
+    """Dadras et al. 2021's heaviest payload standing up, 50 1/m at 0.05 Hz: RMS error of the second
     period below 5 % of the amplitude with feedforward + PI, within the +-1.5 V safe range;
     feedback improves on the feedforward alone (which misses the payload's extra gain)."""
     e_both, r = track(12.6e-6)

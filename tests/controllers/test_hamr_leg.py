@@ -1,4 +1,4 @@
-"""HAMR leg phase control from the self-sensed current (seed 003, section 6.2)."""
+"""HAMR leg phase control from the self-sensed current (Jayaram et al. 2018, section 6.2)."""
 import numpy as np
 import pytest
 
@@ -6,7 +6,7 @@ from mjeap.controllers.hamr_leg import SWING, leg_scene, pid_gains, run_leg
 from mjeap.io.recording import read_recording
 from mjeap.validation.mechanics import free_vibration_frequency
 
-#: seed 003: within 5 degrees in under 25 cycles (250 ms) at 100 Hz
+#: Jayaram et al. 2018: within 5 degrees in under 25 cycles (250 ms) at 100 Hz
 PHASE_TOL_DEG, MAX_CYCLES = 5.0, 25
 
 

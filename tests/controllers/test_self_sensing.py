@@ -1,4 +1,4 @@
-"""Self-sensing velocity estimator (seed 003, eqs. 7-9) on the HAMR small bimorph of the
+"""Self-sensing velocity estimator (Jayaram et al. 2018, eqs. 7-9) on the HAMR small bimorph of the
 catalog (its residual tip mass fitted to the measured 1750 Hz resonance)."""
 import numpy as np
 import pytest
@@ -12,7 +12,7 @@ from mjeap.analysis.frequency import phasor, sine_sweep
 #: the paper's free-actuator bias voltages (Fig. 6) and its 10-2000 Hz range
 BIASES = (20.0, 60.0, 100.0)
 FREQUENCIES = (10, 30, 100, 300, 1000, 1500, 1750, 2000)
-#: seed 003, section 4: estimates within 10 % in magnitude and 10 degrees in phase
+#: Jayaram et al. 2018, section 4: estimates within 10 % in magnitude and 10 degrees in phase
 MAG_TOL, PHASE_TOL = 0.10, 10.0
 R_FIT = 1e9
 
@@ -36,7 +36,7 @@ def capacitance(scene):
 @pytest.mark.slow
 def test_eq8_recovers_the_blocking_factor(scene, sweeps, c_scale):
     """With C_fit = c_scale x the free capacitance (2: the datasheet's 16 nF against the fixed
-    actuator's ~8 nF, seed 003), eq. (8) must return beta = 1 / c_scale, as closely as its
+    actuator's ~8 nF, Jayaram et al. 2018), eq. (8) must return beta = 1 / c_scale, as closely as its
     one-velocity-scale assumption allows: the simulated |v / I_mech| is not one number but
     rises from the uniform arc's 270 to 303 m/(A s) at 2 kHz (the tip block makes the first
     mode's curvature peak at the root). The fit trades that mismatch of the motional current

@@ -1,4 +1,4 @@
-"""Seed 002 electrostriction and seed 003 piezo bimorphs against their closed forms."""
+"""Metello 2020 electrostriction and Jayaram et al. 2018 piezo bimorphs against their closed forms."""
 import numpy as np
 import pytest
 
@@ -80,7 +80,7 @@ def test_piezo_free_deflection_and_blocked_force_match_wood_jafferis(actuator):
 
 def test_piezo_current_parts():
     """Sine drive at 100 Hz, far below the first resonance: the capacitive current has
-    amplitude C 2 pi f A (seed 003 eq. (1)), and the motional current is eq. (13)'s,
+    amplitude C 2 pi f A (Jayaram et al. 2018 eq. (1)), and the motional current is eq. (13)'s,
     2 A f31 d(eps_1)/dt with the plate's mid-plane strain kappa (t_p + t_cf)/2 of the published
     quasi-static free deflection (kappa = 2 delta_f / (L^2 (1 + 2 l_r))), in phase with it;
     2 % (the dynamic amplification at f/f_1 ~ 0.06 is 0.3 %)."""
@@ -104,7 +104,7 @@ TABLE_1 = {"pzt-hamr-large": 1400.0, "pzt-hamr-small": 1750.0, "pzt-robobee": 10
 
 
 def test_piezo_resonance_against_table_1(capsys):
-    """First resonance of the physical parameter set (no residual) beside seed 003 Table 1,
+    """First resonance of the physical parameter set (no residual) beside Jayaram et al. 2018 Table 1,
     printed; the modal analysis converges with the chain (20 vs 40 hinges within 0.5 %). With
     the catalog's residual tip mass the model resonates at Table 1's frequency within 2 %."""
     from mjeap.analysis.calibration import with_residual

@@ -1,4 +1,4 @@
-"""Seed 000: the PEDOT actuator's RC + back-relaxation drive against eqs. (7) and (8)."""
+"""Dadras et al. 2021: the PEDOT actuator's RC + back-relaxation drive against eqs. (7) and (8)."""
 import json
 
 import numpy as np
@@ -34,7 +34,7 @@ def test_square_wave_matches_transfer_function(vpp):
     assert np.sqrt(np.mean((r.tip_curvature - ref) ** 2)) < 0.02 * p2p_ref
 
 
-# Table II of seed 000: payload (kg), l_e (m), initial curvature at 2 and 3 Vpp (1/m)
+# Table II of Dadras et al. 2021: payload (kg), l_e (m), initial curvature at 2 and 3 Vpp (1/m)
 TABLE_II = [(3.15e-6, 6.20e-3, -133.0, -132.0), (6.30e-6, 6.70e-3, -156.0, -241.0),
             (12.60e-6, 6.27e-3, -209.0, -303.0)]
 
@@ -66,11 +66,11 @@ def test_payloads_inverted_stay_finite_and_increase_the_swing(capsys):
                      "p2p_per_m": round(p2p, 1), "unloaded_p2p_per_m": round(float(unloaded[vpp]), 1)})
         assert p2p > 1.02 * unloaded[vpp]
     with capsys.disabled():
-        print("\nseed 000 payload runs (second period):\n" + json.dumps(rows, indent=1))
+        print("\nDadras et al. 2021 payload runs (second period):\n" + json.dumps(rows, indent=1))
 
 
 def test_direct_step_is_the_general_step(monkeypatch):
-    """Seed 000's drive writes its moments straight into the hinge chain's qfrc_applied
+    """Dadras et al. 2021's drive writes its moments straight into the hinge chain's qfrc_applied
     (Part.direct_bending); the general path (set_internal_moments and the state vector) must
     give the same run: curvature, tip and every signal, with gravity, a payload and a
     square wave, to rounding."""

@@ -1,7 +1,7 @@
 """The piezo bimorph's moment per volt against its sources, and energy balances over a cycle.
 
 References, none of them the drive's own formula:
-- seed 003 eq. (13), I_mech = 2 A f31 d(eps_1)/dt, with the plate's bending strain taken from
+- Jayaram et al. 2018 eq. (13), I_mech = 2 A f31 d(eps_1)/dt, with the plate's bending strain taken from
   the simulated tip (the arc through clamp and tip, as the paper's vibrometer sees the tip);
 - Harvard's HAMR actuator model (PZTBender2.m, Jafferis et al. 2015) with its own variables:
   the plates' voltage difference V = V_bias at full drive, D from its layer formula;
@@ -146,7 +146,7 @@ def test_piezo_energy_balance_over_a_cycle(f_ratio, steps_per_period):
 
 @pytest.mark.slow
 def test_seed_000_energy_balances_over_a_cycle():
-    """Seed 000's model is one-way (eq. 8: the double layer does not see the beam's motion), so
+    """Dadras et al. 2021's model is one-way (eq. 8: the double layer does not see the beam's motion), so
     its energy closes on each side. Native pedot-micro, 1.5 V sine at 0.5 Hz, one period after
     two. Electrical: the work V I = the resistor's R I^2 plus the change of the double layer's
     (1/2) C v_c^2, with R = 1/(C p_elec). Mechanical: the drive actuator's work = what the hinge

@@ -1,4 +1,4 @@
-"""Seed 002's unimorphs against the thesis's measurements: the eigenstrain coefficient fitted
+"""Metello 2020's unimorphs against the thesis's measurements: the eigenstrain coefficient fitted
 on one sample predicts the others; field stiffening is off by default; the Maxwell chain uses
 the thesis's layer-sum moment of inertia."""
 import numpy as np

@@ -121,7 +121,7 @@ PLAIN_MUJOCO = textwrap.dedent('''
         t.append(d.time * T)
         kappa.append(2 * y / (x * x + y * y))                                     # arc through clamp and tip
     t, kappa = np.array(t), np.array(kappa)
-    # seed 000, eq. (8): K/V = 63 (s + 0.52) / ((s + 0.3)(s + 1.8)), 3 V step from rest
+    # Dadras et al. 2021, eq. (8): K/V = 63 (s + 0.52) / ((s + 0.3)(s + 1.8)), 3 V step from rest
     _, ref = signal.step(signal.TransferFunction([63.0, 63.0 * 0.52], np.polymul([1, 0.3], [1, 1.8])), T=t)
     ref = 3.0 * ref
     print(np.sqrt(np.mean((kappa - ref) ** 2)) / np.ptp(ref))
@@ -163,9 +163,9 @@ def test_tip_loads_ride_along_in_the_native_engine():
 
 
 def test_the_native_form_follows_hand_set_hinges_and_not_a_leftover_stiffness_scale():
-    """The native model starts from the hinges as built or identified: seed 000's drive once
+    """The native model starts from the hinges as built or identified: Dadras et al. 2021's drive once
     rebuilt its springs and Maxwell arms from the catalog (an identified stiffness did nothing
-    on the native engine), and a stiffness scale a loop run left behind (seed 001's
+    on the native engine), and a stiffness scale a loop run left behind (Mutlu et al. 2013's
     stiffness table) was compiled into the cached native model. Reference: the loop engine,
     the Python drive on the scene's own model."""
     from mjeap import Scene, rollout

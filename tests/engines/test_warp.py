@@ -21,7 +21,7 @@ def needs_warp():
     """Skip where mujoco-warp is not installed (the ``warp`` extra), and only there."""
     pytest.importorskip("mujoco_warp")
 
-#: seed 000's main job (README), shortened: standing up, the 12.6 mg payload at 6.27 mm,
+#: Dadras et al. 2021's main job (README), shortened: standing up, the 12.6 mg payload at 6.27 mm,
 #: square 0.1 Hz from the measured initial curvature; 16 amplitudes as a map's axis
 SCENE = {"orientation": "up", "payload": "12.6mg@6.27mm"}
 AMPLITUDES = np.linspace(0.25, 1.5, 16)

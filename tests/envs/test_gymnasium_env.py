@@ -200,7 +200,7 @@ def test_bad_parameters_refused_before_any_work(monkeypatch):
 def test_held_voltage_follows_rollout_and_eq8():
     """1 V held for 20 s on the unloaded beam lying flat. Consistency: the env's trajectory
     is mjeap.rollout's on the same model (both step the drive in lockstep). Independent
-    reference: seed 000's eq. (8), K/V = 63 (s + 0.52) / ((s + 0.3)(s + 1.8)), whose step
+    reference: Dadras et al. 2021's eq. (8), K/V = 63 (s + 0.52) / ((s + 0.3)(s + 1.8)), whose step
     response in closed form is G0 + A exp(-0.3 t) + B exp(-1.8 t) with the steady gain
     G0 = 63 x 0.52 / (0.3 x 1.8) = 60.67 1/m per V: within 1e-4 of G0 all along, and at
     20 s within 0.2 % of G0 itself (the slow pole has decayed to 0.08 1/m)."""

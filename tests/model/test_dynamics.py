@@ -9,7 +9,7 @@ from mjeap.validation.mechanics import free_vibration_frequency as measured_freq
 @pytest.mark.parametrize("representation", ["hinge", "cable", pytest.param("rod", marks=pytest.mark.slow)])
 @pytest.mark.parametrize("tip_mass", [0.0, 3.15e-6, 12.6e-6])
 def test_first_frequency_within_2_percent(representation, tip_mass):
-    """PEDOT beam, unloaded and with seed 000's payload masses at the tip (NdFeB sphere,
+    """PEDOT beam, unloaded and with Dadras et al. 2021's payload masses at the tip (NdFeB sphere,
     rotary inertia included in the reference). Light damping (zeta_1 = 0.005) so the
     measured damped frequency differs from the undamped one by < 0.002 %."""
     L, EI, m = 6e-3, 1 / 4.86e7, 0.695e-6

@@ -5,7 +5,7 @@ from scipy import signal
 
 from mjeap.model.lti import lsim
 
-SYSTEMS = [signal.TransferFunction([63.0, 63.0 * 0.52], np.polymul([1.0, 0.3], [1.0, 1.8])),  # seed 000 eq. 8
+SYSTEMS = [signal.TransferFunction([63.0, 63.0 * 0.52], np.polymul([1.0, 0.3], [1.0, 1.8])),  # Dadras et al. 2021 eq. 8
            signal.TransferFunction([2.0], [0.01, 1.0]),                                          # fast first order
            signal.TransferFunction([3.0, 0.9], [1.0, 0.52])]                                     # proper (D != 0)
 

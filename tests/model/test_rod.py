@@ -1,7 +1,7 @@
 """The rod representation (mjeap.rod, a 1D flexcomp rod: MuJoCo 4.x) against the same
 analytical references as the hinge chain, within the hinge chain's tolerances (the checks
 the two share are parametrised with the rod where they live: tests/model/test_statics.py,
-tests/model/test_dynamics.py), and against the hinge chain on seed 000's heaviest run; what it
+tests/model/test_dynamics.py), and against the hinge chain on Dadras et al. 2021's heaviest run; what it
 refuses, and why.
 
 The PEDOT beam at the default 20 segments unless said otherwise. The rod is refused on
@@ -99,7 +99,7 @@ def test_buckling_load_within_1_percent():
 
 @pytest.mark.slow
 def test_seed_000_heaviest_run_matches_the_hinge_chain_within_1_percent_of_the_swing():
-    """Seed 000's heaviest run (pedot-micro standing up, 12.6 mg NdFeB payload at 6.27 mm,
+    """Dadras et al. 2021's heaviest run (pedot-micro standing up, 12.6 mg NdFeB payload at 6.27 mm,
     square 3 Vpp at 0.1 Hz for 20 s from -303 1/m, its rc-relaxation drive): the rod's tip
     curvature within 1 % of the swing of the hinge chain's, each at its own default
     timestep (the rod's samples interpolated to the hinge chain's steps). Measured: 0.39 %,

@@ -1,4 +1,4 @@
-"""Multilayer cross-sections against the thesis (seed 002, eqs. 3.1-3.6, Tables 4.1-4.3)."""
+"""Multilayer cross-sections against the thesis (Metello 2020, eqs. 3.1-3.6, Tables 4.1-4.3)."""
 from dataclasses import replace
 
 import pytest

@@ -1,4 +1,4 @@
-"""The HAMR leg of mjeap.robots.hamr_leg (seed 003, section 6.2), shortened (the full sweeps
+"""The HAMR leg of mjeap.robots.hamr_leg (Jayaram et al. 2018, section 6.2), shortened (the full sweeps
 and the 40-cycle run are the script's): two actuators, a rigid leg on swing and lift
 joints, transmissions as tendon equalities, the foot's position from the 3D kinematics.
 
@@ -11,7 +11,7 @@ import pytest
 import harvard
 from mjeap.robots import hamr_leg as leg
 
-#: seed 003: within 5 degrees in under 25 cycles (250 ms) at 100 Hz
+#: Jayaram et al. 2018: within 5 degrees in under 25 cycles (250 ms) at 100 Hz
 PHASE_TOL_DEG, MAX_CYCLES = 5.0, 25
 
 

@@ -1,7 +1,7 @@
-"""HAMR-VI walking (mjeap.robots.hamr_walk; seed 003, section 6.2), shortened: the whole robot
+"""HAMR-VI walking (mjeap.robots.hamr_walk; Jayaram et al. 2018, section 6.2), shortened: the whole robot
 (1.43 g, eight pzt-hamr-small actuators, four hamr_leg legs, contact feet) trots open loop.
 
-References: the robot's mass and length from seed 003; for the speed, the no-slip kinematic
+References: the robot's mass and length from Jayaram et al. 2018; for the speed, the no-slip kinematic
 estimate from the simulated foot path relative to the body (the stance feet's backward
 speed, the body's speed if no stance foot slid), an estimate independent of the body's
 world motion. The full-amplitude trot (the signal 0..200 V) is checked to move forward,

@@ -1,5 +1,5 @@
 """HAMR-VI's eight phase loops on the self-sensed currents (mjeap.robots.hamr_walk; issue 25,
-seed 003 section 6.2), at 20 V, 80 Hz: the lift transmissions' resonance, where open loop
+Jayaram et al. 2018 section 6.2), at 20 V, 80 Hz: the lift transmissions' resonance, where open loop
 each lift lags its drive most (the single leg's second-order model: 90 degrees) and the
 swings (100 Hz) little (12.5 degrees).
 

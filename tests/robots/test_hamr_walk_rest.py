@@ -3,7 +3,7 @@ the robot's physics (hamr_walk.contact_parameters: time constant 10 steps = 45 u
 critically damped, the actuators under the 'discrete' integrator).
 
 References: Newton's laws. A robot at rest is not accelerating, so the ground's normal
-forces add up to its weight, TOTAL_MASS x g (1.43 g, seed 003), at every step; a body at
+forces add up to its weight, TOTAL_MASS x g (1.43 g, Jayaram et al. 2018), at every step; a body at
 rest does not move (creep, the soft friction's slow slide, is held to 1 um/s). A robot on
 its back lies on its chassis: the body's frame (the chassis's bottom face) then sits
 BODY_HEIGHT above the ground. Before this contact (2-step time constant, 'implicitfast')

@@ -52,7 +52,7 @@ def test_transmission_reflects_the_wing_inertia_onto_the_tip():
 @pytest.mark.slow
 def test_stroke_peaks_between_30_and_270_hz_and_is_self_sensed():
     """The stroke rises to the transmission resonance and falls after it; self-sensed within
-    seed 003's 10 % at 30 and 90 Hz. At 270 Hz the wing's inertia nearly blocks the
+    Jayaram et al. 2018's 10 % at 30 and 90 Hz. At 270 Hz the wing's inertia nearly blocks the
     actuator: the motional current is a small part of the total, so the estimate's error
     is the calibrated blocking factor's own error times the dielectric-to-motional current
     ratio there (eq. 7: I_sen = I_mech + (1 - beta) C dV/dt), which the bound adds to the

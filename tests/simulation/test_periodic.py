@@ -41,14 +41,14 @@ def test_a_stopped_run_is_the_full_runs_start_and_its_rest_repeats_the_last_peri
 @pytest.mark.slow
 def test_a_run_still_relaxing_runs_on_until_its_drift_is_within_the_tolerance():
     """From a bent start (-300 1/m) the curvature relaxes on the mechanical pole, the
-    zero-input term of seed 000's eq. (7): period to period it drifts by
+    zero-input term of Dadras et al. 2021's eq. (7): period to period it drifts by
     d = 300 exp(-p (t - T)) (1 - exp(-p T)) 1/m, shrinking by rho = exp(-p T) a period, against
     the swing of the sine's steady state, 2 x 0.5 V x |K(j w)| of eq. (8) (17.6 1/m). The stop
     must come at the first boundary (from the third) where d and all drift still to come,
     d rho / (1 - rho), are within the tolerance of the swing (the drive's own start transient,
     left out of this estimate, may add a period), and a run whose drift stays above it (1e-3:
     past 30 s) must run to its end."""
-    k, z, p, a = 63.0, 0.52, 0.3, 1.8                     # eq. (8), seed 000
+    k, z, p, a = 63.0, 0.52, 0.3, 1.8                     # eq. (8), Dadras et al. 2021
     T, w = 2.0, 2 * np.pi * 0.5
     swing = 2 * 0.5 * abs(k * (1j * w + z) / ((1j * w + p) * (1j * w + a)))
 

@@ -131,7 +131,7 @@ def test_pacing_arithmetic():
 
 def test_mjcf_command_writes_the_driven_model_in_volts_and_seconds(tmp_path):
     """mjeap mjcf NAME: the model with its drive (actuator 'drive', ctrlrange the drive's
-    range in V, the RC pole 1.8 /s of seed 000 as filter time constant in s); the same
+    range in V, the RC pole 1.8 /s of Dadras et al. 2021 as filter time constant in s); the same
     model as the shipped file."""
     out = tmp_path / "pedot.xml"
     assert main(["mjcf", "pedot-micro", "-o", str(out)]) == 0

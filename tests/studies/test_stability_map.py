@@ -1,4 +1,4 @@
-"""The stability map of seed 000's inverted actuator (mjeap.studies.stability_map, mjeap.studies.stability_map, scripts/stability_map.py).
+"""The stability map of Dadras et al. 2021's inverted actuator (mjeap.studies.stability_map, mjeap.studies.stability_map, scripts/stability_map.py).
 
 Physics claim: the simulated payload limit sits at the static column load with the relaxed
 EI (76 mg at l_e = 6.27 mm), not at the paper's Region 3 model (46 mg) or the instantaneous

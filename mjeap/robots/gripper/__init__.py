@@ -1,4 +1,4 @@
-"""PEDOT micro-gripper (seed 000's actuator, built for micromanipulation): two pedot-micro
+"""PEDOT micro-gripper (Dadras et al. 2021's actuator, built for micromanipulation): two pedot-micro
 fingers close on a steel bead resting on a table, hold it and lift it (``mjeap robot
 gripper``).
 

@@ -1,4 +1,4 @@
-"""HAMR single leg (seed 003, section 6.2): two pzt-hamr-small actuators drive a rigid leg
+"""HAMR single leg (Jayaram et al. 2018, section 6.2): two pzt-hamr-small actuators drive a rigid leg
 through its swing and lift transmissions (``mjeap robot hamr-leg``).
 
 The robot in two modules: :mod:`mjeap.robots.hamr_leg.model` (the leg's design, builder and

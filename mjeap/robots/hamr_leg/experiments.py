@@ -1,4 +1,4 @@
-"""HAMR single leg (seed 003, section 6.2): two pzt-hamr-small actuators drive a rigid leg
+"""HAMR single leg (Jayaram et al. 2018, section 6.2): two pzt-hamr-small actuators drive a rigid leg
 through its swing and lift transmissions; resonances from sine sweeps, then the foot
 ellipse at 100 Hz open loop and with both phase loops closed on the self-sensed currents.
 
@@ -14,7 +14,7 @@ self-sensed phase PID of mjeap.controllers.hamr_leg (each actuator's drive curre
 own estimator, calibrated on the free actuator; no simulator state), its gains from each
 transmission's second-order model (phase_loop_gains: the swing at resonance, the lift 20 Hz
 above its own). Desired foot motion:
-swing sin(omega t), lift 90 degrees ahead: the ellipse of seed 003's ref. [50].
+swing sin(omega t), lift 90 degrees ahead: the ellipse of Jayaram et al. 2018's ref. [50].
 
 The leg itself (design, builder, read-out) is :mod:`mjeap.robots.hamr_leg.model`.
 """

@@ -8,7 +8,7 @@ Model (host in mm, mg, ms; gravity along -z):
   down (z): the foot's position is the 3D kinematics of these joints.
 - Each transmission (mjeap.simulation.system.add_transmission): a tendon equality that turns the leg
   joint by T d / LEG_LENGTH, d the actuator's tip deflection linearised in its hinge angles,
-  so that the foot moves T x the tip for small motion (T_swing = 13, T_lift = 12, seed 003
+  so that the foot moves T x the tip for small motion (T_swing = 13, T_lift = 12, Jayaram et al. 2018
   from its ref. [51]).
 - Inertia: for each degree of freedom, the tip mass that puts the loaded actuator's first
   mode at the paper's transmission resonance (100 Hz swing, 80 Hz lift: the point-mass leg
@@ -18,7 +18,7 @@ Model (host in mm, mg, ms; gravity along -z):
 - Damping: each leg joint damps its transmission mode to ZETA (less the actuator's own
   stiffness-proportional share at that frequency, zeta_act f / f_free), as the point-mass
   scene's damping is set on its loaded mode.
-- LEG_LENGTH = 10 mm is ASSUMED (a quarter of HAMR-VI's 4.51 cm body, seed 003); with the
+- LEG_LENGTH = 10 mm is ASSUMED (a quarter of HAMR-VI's 4.51 cm body, Jayaram et al. 2018); with the
   ratios fixed it sets only the joint angles, i.e. the kinematic nonlinearity.
 """
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""HAMR-VI walks (issue 25; seed 003, section 6.2): a free-floating 1.43 g, 4.51 cm
+"""HAMR-VI walks (issue 25; Jayaram et al. 2018, section 6.2): a free-floating 1.43 g, 4.51 cm
 quadruped, four legs of two pzt-hamr-small actuators each, trotting on a ground plane
 (``mjeap robot hamr-walk``).
 

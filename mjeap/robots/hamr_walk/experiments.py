@@ -1,4 +1,4 @@
-"""HAMR-VI walks (issue 25; seed 003, section 6.2): a free-floating 1.43 g, 4.51 cm
+"""HAMR-VI walks (issue 25; Jayaram et al. 2018, section 6.2): a free-floating 1.43 g, 4.51 cm
 quadruped, four legs of two pzt-hamr-small actuators each (the legs of
 mjeap.robots.hamr_leg), trotting on a ground plane open loop at the paper's 200 V bias.
 
@@ -20,7 +20,7 @@ component API (attach, System, ContactParameters, add_transmission) and plain Mj
 Gait (trot): per actuator V = V_bias/2 + a sin(omega t + phi), a = AMPLITUDE = 100 V by
 default (full: the signal swings 0..200 V); the diagonal pairs (front-left + rear-right,
 front-right + rear-left) in phase, the pairs 180 degrees apart, each lift 90 degrees ahead of
-its swing (the foot ellipse of seed 003's ref. [50]: with foot x ~ sin and z ~ cos the foot
+its swing (the foot ellipse of Jayaram et al. 2018's ref. [50]: with foot x ~ sin and z ~ cos the foot
 is down while it moves backward). The amplitude is ramped over the first 2 cycles
 (:class:`SoftStart`, as Doshi's simulations ramp theirs): a lift 90 degrees ahead would
 otherwise start with a 100 V step. Open loop: near the transmission resonances each foot
@@ -174,11 +174,11 @@ from .model import (BIAS, CONTACT_WIDTH_FRACTION, FOOT_RADIUS, FREQUENCY_RANGE, 
                     ground_rotation, model_summary, roll_pitch)
 
 AMPLITUDE = 0.5 * BIAS          # V, full amplitude: the signal swings 0..V_bias
-PAPER_SPEED, PAPER_FREQUENCY = 0.5, 65.0      # m/s at Hz, seed 003
+PAPER_SPEED, PAPER_FREQUENCY = 0.5, 65.0      # m/s at Hz, Jayaram et al. 2018
 #: V: a lift amplitude at which the full-swing 65 Hz trot stays upright (hamr_walk.study: 20 and
 #: 30 V upright, 40 V and full roll over), run beside the full drive where that rolls over
 LIMITED_LIFT = 20.0
-PAPER_INCLINE = 22.0                          # deg, seed 003 ("inclines nearing 22 deg")
+PAPER_INCLINE = 22.0                          # deg, Jayaram et al. 2018 ("inclines nearing 22 deg")
 FREQUENCIES = (5.0, 10.0, 20.0, 40.0, 65.0, 80.0, 100.0)
 RECORD_FREQUENCY = 10.0                       # Hz: the recorded run (at full amplitude it trots upright there)
 SETTLE = 0.1                    # s at least, and SETTLE_CYCLES cycles, before measuring
@@ -403,7 +403,7 @@ LOOP_FREQUENCY, LOOP_AMPLITUDE = 80.0, 20.0     # Hz, V: the lifts' resonance: o
 OPEN_LOOP_CYCLES = RAMP_CYCLES + 4              # cycles before the loops close (the soft start, then 4)
 LOOP_CYCLES = 40                                # cycles of a closed-loop walk, the open-loop ones included
 LOOP_MEASURE_CYCLES = 16                        # the walk metrics of a closed-loop walk: its last cycles
-PHASE_TOL_DEG = 5.0                             # deg, seed 003's "within 5 degrees"
+PHASE_TOL_DEG = 5.0                             # deg, Jayaram et al. 2018's "within 5 degrees"
 #: Hz, the free actuator's calibration sweep (as the single leg's free_estimator)
 ESTIMATOR_FREQUENCIES = (100.0, 1000.0, 1500.0, 1750.0, 2000.0)
 FOOT_AXIS = {"swing": 0, "lift": 2}             # the foot's body-frame coordinate: fore-aft x, normal z

@@ -3,12 +3,12 @@ its read-outs.
 
 Model (host in mm, mg, ms; gravity along -z; x forward, y left, z up):
 - Body: a free body (freejoint), BODY_LENGTH = 45.1 mm long, the whole robot TOTAL_MASS =
-  1.43 g (seed 003: "a 4.51 cm long, 1.43 g quadrupedal microrobot"); width 15 mm and height
+  1.43 g (Jayaram et al. 2018: "a 4.51 cm long, 1.43 g quadrupedal microrobot"); width 15 mm and height
   4 mm ASSUMED; the body's own mass (a uniform box, 0.49 g) is what the eight actuators
   (0.48 g) and the four legs (0.46 g) leave.
 - Legs: mjeap.robots.hamr_leg.add_leg with the single leg's design (hamr_leg.design():
   joint inertias that put the loaded actuators at the transmission resonances, 100 Hz swing
-  and 80 Hz lift, zeta 0.05; T_swing = 13, T_lift = 12, seed 003 from its ref. [51];
+  and 80 Hz lift, zeta 0.05; T_swing = 13, T_lift = 12, Jayaram et al. 2018 from its ref. [51];
   LEG_LENGTH 10 mm, ASSUMED there), one per corner: hips at x = +-HIP_X (14 mm, ASSUMED),
   y = +-7.5 mm (the body's sides), the rod outward along +-y, the foot FOOT_DROP = 11.35 mm
   below its end on a massless shank (the foot's offset below its leg frame in N. Doshi's
@@ -51,8 +51,8 @@ from ...errors import ParameterError, check_integer, check_range
 from ...simulation.system import ContactParameters, System, attach
 from ..hamr_leg.model import ACTUATOR, LEG_LENGTH, add_leg, design
 
-TOTAL_MASS = 1.43e-3            # kg, seed 003
-BODY_LENGTH = 45.1e-3           # m, seed 003
+TOTAL_MASS = 1.43e-3            # kg, Jayaram et al. 2018
+BODY_LENGTH = 45.1e-3           # m, Jayaram et al. 2018
 BODY_WIDTH = 15e-3              # m, assumed
 BODY_HEIGHT = 4e-3              # m, assumed
 HIP_X = 14e-3                   # m, assumed (hips 28 mm apart fore-aft)
@@ -280,8 +280,8 @@ def model_summary(system: System) -> dict:
             "body_length_m": BODY_LENGTH, "body_width_m": BODY_WIDTH, "body_height_m": BODY_HEIGHT,
             "hip_x_m": HIP_X, "leg_length_m": LEG_LENGTH, "foot_drop_m": FOOT_DROP, "foot_radius_m": FOOT_RADIUS,
             "timestep_s": system.timestep, "segments": system.parts[0].layout.segments,
-            "cited": {"total mass, body length, 0.5 m/s at 65 Hz, 22 deg": "seed 003 section 6.2 (Jayaram 2018)",
-                      "T_swing 13, T_lift 12, resonances 100 / 80 Hz": "seed 003 section 6.2 (its refs [51], [19])",
+            "cited": {"total mass, body length, 0.5 m/s at 65 Hz, 22 deg": "Jayaram et al. 2018 section 6.2 (Jayaram 2018)",
+                      "T_swing 13, T_lift 12, resonances 100 / 80 Hz": "Jayaram et al. 2018 section 6.2 (its refs [51], [19])",
                       "foot 11.35 mm below its leg frame, mu 0.51, drive ramped over 2 cycles":
                           "N. Doshi's HAMR Drake simulation scripts (HamrRBM FOOT_POS, trot sweeps MU)"},
             "assumed": ["body width and height", "hip spacing", "leg length (hamr_leg)", "foot radius",

@@ -33,7 +33,7 @@ contact under 'implicitfast', after the fix of hamr_leg.add_leg's stage centre o
   14 % of the time at 20 V). The trot is chaotic: before, lift 30 V at mu 0.50 pitched to
   35 deg, at mu 0.52 it ran at 0.49 m/s.
 - The true lift amplitude of HAMR-VI's foot at 65 Hz is not published here (the paper's
-  phase loop, seed 003, and a loaded leg's damping would both change it); the defaults are
+  phase loop, Jayaram et al. 2018, and a loaded leg's damping would both change it); the defaults are
   kept, and the 65 Hz speed comes within a factor of 2.6 of the paper's 0.5 m/s only with
   the lift at 20-30 V (0.18-0.20 m/s; before 0.19-0.49).
 

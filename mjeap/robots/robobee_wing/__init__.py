@@ -1,4 +1,4 @@
-"""RoboBee wing (seed 003, section 6.1): one pzt-robobee actuator flaps a rigid wing through
+"""RoboBee wing (Jayaram et al. 2018, section 6.1): one pzt-robobee actuator flaps a rigid wing through
 its transmission, in air (``mjeap robot robobee-wing``).
 
 The robot in two modules: :mod:`mjeap.robots.robobee_wing.model` (the wing's builder and

@@ -1,4 +1,4 @@
-"""RoboBee wing (seed 003, section 6.1): one pzt-robobee actuator flaps a rigid wing through
+"""RoboBee wing (Jayaram et al. 2018, section 6.1): one pzt-robobee actuator flaps a rigid wing through
 its transmission, in air; stroke amplitude against frequency, and the self-sensing estimate.
 
     mjeap robot robobee-wing [--out out/robobee_wing.rrd] [--quick]

@@ -5,13 +5,13 @@ Model (host in mm, mg, ms):
 - the wing: a rigid plate on a stroke hinge, MuJoCo's ellipsoid fluid model in air
   (1.2 kg/m^3, 1.8e-5 Pa s);
 - the transmission (mjeap.simulation.system.add_transmission): a tendon equality stroke = T_eff x the
-  actuator's tip deflection linearised in its hinge angles, T_eff = 4000 rad/m (seed 003,
+  actuator's tip deflection linearised in its hinge angles, T_eff = 4000 rad/m (Jayaram et al. 2018,
   from its ref. [48]): the small-motion transmission the paper uses to turn the actuator's
   motion into a stroke angle.
 - Wing: 15 mm long, 5 mm mean chord, 0.51 mg. Not in the seeds; taken from a secondary
   source, the Harvard Microrobotics Lab's public RoboBee wing models (github.com/avikde/
   robobee3d, flapopt/Wing2DOF.py: R = 15 mm, m_wing = 0.51 mg; flapopt/wingopt.py: mean
-  chord 5 mm). The length agrees with seed 003's 3.5 cm wingspan (two wings and a ~5 mm
+  chord 5 mm). The length agrees with Jayaram et al. 2018's 3.5 cm wingspan (two wings and a ~5 mm
   thorax). Drawn as a 15 x 5 mm plate; MuJoCo's ellipsoid model sees the inscribed
   ellipse (pi/4 of the plate's area). The resonance scales with 1/sqrt(wing inertia).
 """
@@ -21,7 +21,7 @@ import mujoco
 
 from ...simulation.system import System, add_transmission, attach
 
-T_EFF = 4000.0                                  # rad/m, seed 003 section 6.1
+T_EFF = 4000.0                                  # rad/m, Jayaram et al. 2018 section 6.1
 SPAN, CHORD, THICKNESS = 15e-3, 5e-3, 20e-6     # m (length, mean chord: secondary source; thickness drawn)
 WING_MASS = 0.51e-6                             # kg (secondary source, see the module text)
 HINGE_OFFSET = 1e-3                             # m, wing root beyond the stroke axis (drawn)

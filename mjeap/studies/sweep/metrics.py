@@ -4,6 +4,20 @@ sets beside it say which need no rollout (:data:`STATIC_METRICS`: ``first_freque
 ``mass``), which read only the run's end or every step of its last period (how a point's
 rollout is sampled) and which need the run's own scene; :func:`check_metric_settings`
 refuses, before any point runs, a metric its points cannot give.
+
+No metric is read at an arbitrary instant of a periodic run: under a periodic drive (square,
+sine, triangle) a metric reads the last whole period (``peak_to_peak``, ``returns``,
+``stroke``, ``peak_power``, ``energy_per_cycle``), the whole run (``max_*``) or no run at all
+(``first_frequency``, ``mass``, ``capacitance``, the fields); ``free_deflection``,
+``blocked_force``, ``energy_density`` and ``settling_time`` keep their step meaning and are
+refused there (:data:`STEP_ONLY_METRICS`), ``stroke`` under a step
+(:data:`PERIODIC_ONLY_METRICS`).
+
+The piezo metrics (``stroke`` aside) read the point's laminate, the actuator's stack wired as
+its drive wires it (:mod:`mjeap.model.laminate`; ``piezo`` and ``piezo-bimorph``):
+``max_field``, ``max_reverse_field`` (V/m, from the waveform's extreme voltages: a field is
+linear in V), ``max_stress`` (Pa, from every hinge's curvature and the voltage over the
+run) and ``capacitance`` (F, the free capacitance the signal terminal sees).
 """
 from __future__ import annotations
 
@@ -12,7 +26,7 @@ from typing import Callable, Dict, Optional, Sequence
 import numpy as np
 
 from ...errors import DivergenceError, ParameterError, check_registration
-from ...simulation.metric_scales import reported_value
+from ...simulation.metric_scales import peak_to_peak, reported_value
 from .points import PARAMETERS
 
 
@@ -29,14 +43,16 @@ def metric_peak_to_peak(r, point, scene) -> float:
 
 
 def metric_returns(r, point, scene) -> bool:
-    """Seed 000's stability criterion: the tip curvature still changes sign in the last
+    """Dadras et al. 2021's stability criterion: the tip curvature still changes sign in the last
     drive period (the actuator follows the drive instead of staying collapsed); at a target on
     it, decided on the margin the accuracy report gives."""
     return reported_value(r, "returns", _period(point)) > 0
 
 
 def metric_settling_time(r, point, scene) -> float:
-    """Time (s) after which the tip curvature stays within 2 % of its final change."""
+    """Time (s) after which the tip curvature stays within 2 % of its final change (a step
+    drive: refused under a periodic one, which has no final value)."""
+    _step_only(point, "settling_time")
     k = r.tip_curvature
     band = 0.02 * max(abs(k[-1] - k[0]), 1e-300)
     outside = np.nonzero(np.abs(k - k[-1]) > band)[0]
@@ -91,7 +107,7 @@ def metric_mass(r, point, scene) -> float:
     """Mass (kg) of the beam (its free length) and its rigid tip block, without a payload;
     no rollout."""
     act = scene.actuator
-    return float(act.total_mass() + act.planform.tip_block_mass)
+    return float(act.actuator_mass())
 
 
 def _end_tip(r, scene):
@@ -106,8 +122,102 @@ def _end_tip(r, scene):
 def metric_free_deflection(r, point, scene) -> float:
     """Free deflection (m): the tip's displacement normal to the undeformed beam (the clamp
     frame's y) at the run's end, under the run's voltage (signed: + towards +y; the scene's
-    gravity and payload act too: hanging or standing, along the beam)."""
+    gravity and payload act too: hanging or standing, along the beam). A step drive's:
+    refused under a periodic one (read ``stroke``)."""
+    _step_only(point, "free_deflection")
     return float(_end_tip(r, scene)[1])
+
+
+def _periodic(point) -> bool:
+    return str(point.get("waveform", "")).strip().lower() in PERIODIC_WAVEFORMS
+
+
+def _step_only(point, name: str) -> None:
+    """Refuse metric ``name`` (a step's) at a point with a periodic waveform."""
+    if _periodic(point):
+        raise ParameterError("metrics", name, STEP_ONLY_METRICS[name],
+                             f"the point's waveform is {point.get('waveform')}: a periodic run has no final value")
+
+
+def metric_stroke(r, point, scene) -> float:
+    """Stroke (m): the peak-to-peak tip deflection (the clamp frame's y) over the last whole
+    drive period of a periodic drive (square, sine or triangle); refused under a step (read
+    ``free_deflection``)."""
+    if not _periodic(point):
+        raise ParameterError("metrics", "stroke", PERIODIC_ONLY_METRICS["stroke"],
+                             f"the point's waveform is {point.get('waveform') or 'none'}")
+    return float(peak_to_peak(r.time, r.tip_position[:, 1], _period(point)))
+
+
+def _laminate(point, scene, name: str):
+    """The point's laminate (its actuator wired as its drive wires it) and drive; a drive
+    without one (not a piezo drive) is refused naming ``name``."""
+    from ...drives import make_drive
+    from ...drives.piezo import LinearPiezo
+    drv = make_drive(None, scene, **{k[6:]: v for k, v in point.items() if k.startswith("drive.")})
+    if not isinstance(drv, LinearPiezo):
+        raise ParameterError("metrics", name, PIEZO_ONLY, f"{scene.actuator.id}'s drive is {drv.name}")
+    return drv.laminate(), drv
+
+
+def _voltage_extremes(point) -> np.ndarray:
+    """The lowest and highest voltage (V) of the point's waveform over its run: a step's
+    amplitude; a periodic waveform's offset -/+ amplitude where the run lasts a period, else
+    the waveform sampled finely over the run."""
+    from ...drives.waveforms import parse_waveform
+    from .points import _duration, _wave_text
+    wave = parse_waveform(_wave_text(point))
+    if wave.kind == "step":
+        return np.array([wave.amplitude])
+    duration = _duration(point)
+    if duration * wave.frequency >= 1.0:
+        return wave.offset + np.array([-1.0, 1.0]) * abs(wave.amplitude)
+    v = wave(np.linspace(0.0, duration, 20001))
+    return np.array([v.min(), v.max()])
+
+
+def metric_max_field(r, point, scene) -> float:
+    """Largest |field| (V/m) in any piezo layer over the run: V_j / t_j at the waveform's
+    extreme voltages (a field is linear in V); no rollout."""
+    lam, _ = _laminate(point, scene, "max_field")
+    return lam.max_field(_voltage_extremes(point))[0]
+
+
+def metric_max_reverse_field(r, point, scene) -> float:
+    """Largest field against a piezo layer's poling (V/m, 0 where none) over the run: the
+    depolarisation risk; no rollout."""
+    lam, _ = _laminate(point, scene, "max_reverse_field")
+    return lam.max_reverse_field(_voltage_extremes(point))[0]
+
+
+def metric_capacitance(r, point, scene) -> float:
+    """Free capacitance (F) the signal terminal sees: eps0 eps33^T A / t summed over the
+    piezo layers whose voltage follows V (signal and complement). For a piezo-bimorph file,
+    which has no permittivity, the model's low-frequency charge per volt
+    C + Gamma^2 int dx / EI instead (its C, the capacitance parameter, is the blocked term);
+    no rollout."""
+    _, drv = _laminate(point, scene, "capacitance")
+    return float(drv.capacitances()["free"][0])
+
+
+def metric_max_stress(r, point, scene) -> float:
+    """Largest |axial stress| (Pa) in any layer over the run: at each hinge and sample, from
+    the hinge's curvature (its rotation / the segment length), the free strains at the
+    sample's voltage and the neutral axis, at every layer's outer fibres, the beam free to
+    stretch (:meth:`mjeap.model.laminate.Laminate.stress_coefficients`)."""
+    lam, _ = _laminate(point, scene, "max_stress")
+    lay = scene.layout
+    c = np.asarray(r.centreline, float)                    # (n, N + 2, 3): clamp, hinges, tip
+    seg = np.diff(c[:, :, :2], axis=1)
+    phi = np.unwrap(np.arctan2(seg[..., 1], seg[..., 0]), axis=1)
+    kappa = np.diff(phi, axis=1) / lay.ds                  # (n, N): each hinge's rotation over its segment
+    v = np.asarray(r.voltage, float)
+    worst = 0.0
+    for j, x in enumerate(lay.hinge_x):
+        dk, dv, c0 = lam.stress_coefficients(x)
+        sigma = kappa[:, j, None, None] * dk + v[:, None, None] * dv + c0
+        worst = max(worst, float(np.abs(sigma).max()))
+    return worst
 
 
 #: the tip must come back to within this fraction of its free deflection for a blocked force
@@ -121,7 +231,9 @@ def metric_blocked_force(r, point, scene) -> float:
     is then found by the secant method, each trial settled again, until the tip is back
     within BLOCKED_TOL of its free deflection (geometric nonlinearity included; 2-4
     settles). Reported as the force the actuator exerts on the block: the same sign as the
-    free deflection. Needs the run's own scene: not at an accuracy target."""
+    free deflection. Needs the run's own scene: not at an accuracy target. A step drive's:
+    refused under a periodic one (read ``stroke``)."""
+    _step_only(point, "blocked_force")
     cached = r.meta.get("_blocked_force")
     if cached is not None:
         return cached
@@ -174,7 +286,8 @@ def _forward(scene) -> None:
 
 def metric_energy_density(r, point, scene) -> float:
     """Energy density (J/kg): blocked_force x free_deflection / (2 mass), mass the beam's and
-    its tip block's (:func:`metric_mass`)."""
+    its tip block's (:func:`metric_mass`); a step drive's, as theirs."""
+    _step_only(point, "energy_density")
     return float(metric_blocked_force(r, point, scene) * metric_free_deflection(r, point, scene)
                  / (2.0 * metric_mass(r, point, scene)))
 
@@ -236,10 +349,12 @@ METRICS: Dict[str, Callable] = {
     "max_stress_proxy": metric_max_stress_proxy, "max_tip_deflection": metric_max_tip_deflection,
     "first_frequency": metric_first_frequency, "mass": metric_mass, "free_deflection": metric_free_deflection,
     "blocked_force": metric_blocked_force, "energy_density": metric_energy_density,
-    "peak_power": metric_peak_power, "energy_per_cycle": metric_energy_per_cycle,
+    "peak_power": metric_peak_power, "energy_per_cycle": metric_energy_per_cycle, "stroke": metric_stroke,
+    "max_field": metric_max_field, "max_reverse_field": metric_max_reverse_field, "max_stress": metric_max_stress,
+    "capacitance": metric_capacitance,
 }
 #: metrics that need no rollout: the point's scene alone (``fn(None, point, scene)``)
-STATIC_METRICS = {"first_frequency", "mass"}
+STATIC_METRICS = {"first_frequency", "mass", "max_field", "max_reverse_field", "capacitance"}
 #: metrics that read only the run's end: their points sample sparsely (the scene holds the end)
 END_METRICS = {"free_deflection", "blocked_force", "energy_density"}
 #: metrics that read every step of the last period: their points sample every step
@@ -251,7 +366,26 @@ OWN_SCENE_METRICS = {"blocked_force", "energy_density"}
 #: SI units of the built-in metrics (constraints of mjeap.optimize may carry units)
 METRIC_UNITS = {"peak_to_peak": "1/m", "settling_time": "s", "max_stress_proxy": "Pa", "max_tip_deflection": "m",
                 "first_frequency": "Hz", "mass": "kg", "free_deflection": "m", "blocked_force": "N",
-                "energy_density": "J/kg", "peak_power": "W", "energy_per_cycle": "J"}
+                "energy_density": "J/kg", "peak_power": "W", "energy_per_cycle": "J", "stroke": "m",
+                "max_field": "V/m", "max_reverse_field": "V/m", "max_stress": "Pa", "capacitance": "F"}
+#: the waveforms of a periodic drive (the others: a step)
+PERIODIC_WAVEFORMS = ("square", "sine", "triangle")
+#: metrics with a step's meaning, refused under a periodic drive: what to read instead
+STEP_ONLY_METRICS = {
+    "free_deflection": "a step drive (a periodic run has no final deflection: read stroke, the peak-to-peak tip "
+                       "deflection over the last whole periods, or use --voltage step:V)",
+    "blocked_force": "a step drive (a periodic run has no final state to block: read stroke under a periodic drive, or "
+                     "use --voltage step:V)",
+    "energy_density": "a step drive (blocked_force x free_deflection of a step: read stroke under a periodic drive, "
+                      "or use --voltage step:V)",
+    "settling_time": "a step drive (settling after a step: a periodic run has no final value; read peak_to_peak or "
+                     "stroke)"}
+#: metrics of a periodic drive, refused under a step: what to read instead
+PERIODIC_ONLY_METRICS = {"stroke": "a periodic waveform (square, sine or triangle with a frequency > 0): under a step "
+                                   "read free_deflection"}
+#: metrics that read a piezo laminate (the piezo and piezo-bimorph drives)
+PIEZO_METRICS = ("max_field", "max_reverse_field", "max_stress", "capacitance")
+PIEZO_ONLY = "an actuator with a piezo drive (piezo or piezo-bimorph: a laminate of piezo layers)"
 
 
 #: a row's own columns, which no metric may be named
@@ -291,21 +425,56 @@ def metric_value(name: str, value):
 
 def check_metric_settings(points: Sequence[dict], base: Optional[dict], metrics: Sequence[str]) -> None:
     """Metrics their points cannot give, refused before any work: a blocked force (and the
-    energy density) at an accuracy target (it is simulated on the run's own scene), power
-    metrics without a periodic waveform."""
+    energy density) at an accuracy target (it is simulated on the run's own scene), a step's
+    metric under a periodic waveform and ``stroke`` under a step (:data:`STEP_ONLY_METRICS`,
+    :data:`PERIODIC_ONLY_METRICS`), power metrics without a periodic waveform, a piezo metric
+    of an actuator without a piezo drive."""
     base = base or {}
+    _check_piezo_metrics(points, base, metrics)
     for p in points or [{}]:
         full = {**PARAMETERS, **base, **p}
         own = [m for m in metrics if m in OWN_SCENE_METRICS]
         if own and full["accuracy"] not in (None, ""):
             raise ParameterError("metrics", own[0], "a study without an accuracy target (the blocked force is "
                                  "simulated on the run's own scene, which a target replaces by the models it chooses)")
+        wave = str(full["waveform"]).strip().lower()
+        for m in metrics:
+            if m in STEP_ONLY_METRICS and wave in PERIODIC_WAVEFORMS:
+                raise ParameterError("metrics", m, STEP_ONLY_METRICS[m],
+                                     f"the waveform is {wave}: refused before any work")
+            if m in PERIODIC_ONLY_METRICS and wave not in PERIODIC_WAVEFORMS:
+                raise ParameterError("metrics", m, PERIODIC_ONLY_METRICS[m], f"the waveform is {wave}")
         power = [m for m in metrics if m in STEP_METRICS]
         if power and (str(full["waveform"]).strip().lower() not in ("square", "sine", "triangle")
                       or not _positive(full["frequency"])):
             raise ParameterError("metrics", power[0], "a periodic waveform (square, sine or triangle with a frequency "
                                  "> 0) for peak_power and energy_per_cycle",
                                  f"a point has waveform={full['waveform']!r}, frequency={full['frequency']!r}")
+
+
+def _check_piezo_metrics(points, base, metrics) -> None:
+    """A piezo metric (:data:`PIEZO_METRICS`) of a point whose actuator's drive is no piezo
+    drive, refused (once per actuator) before any work."""
+    wanted = [m for m in metrics if m in PIEZO_METRICS]
+    if not wanted:
+        return
+    from ...drives import default_drive_name, get_drive_class
+    from ...drives.piezo import LinearPiezo
+    from ...errors import MjeapError
+    from ...model.catalog import get_actuator
+    seen = set()
+    for p in points or [{}]:
+        act = {**PARAMETERS, **base, **p}["actuator"]
+        key = act if isinstance(act, str) else id(act)
+        if key in seen:
+            continue
+        seen.add(key)
+        try:
+            cls = get_drive_class(default_drive_name(get_actuator(act)))
+        except MjeapError:
+            continue                    # an unknown actuator: its points report it
+        if not issubclass(cls, LinearPiezo):
+            raise ParameterError("metrics", wanted[0], PIEZO_ONLY, f"the actuator's drive is {cls.name}")
 
 
 def _positive(x) -> bool:

@@ -33,6 +33,7 @@ from ...io import csvio
 from ...errors import (DivergenceError, MjeapError, OutputError, ParameterError, UnknownNameError, check_integer,
                       sigterm_as_interrupt)
 from ...io.outputs import hold
+from ...model.laminate import FieldWarning
 from . import metrics as _metrics      # its registries, read where a point runs
 from .points import (PARAMETERS, _check_names, _duration, _scene, _wave_text, check_design_size, check_settings,
                      point_id, settings)
@@ -56,22 +57,9 @@ def evaluate(point: dict, metrics: Sequence[str] = ("peak_to_peak", "returns"), 
         row[m] = ""
     t0 = time.perf_counter()
     try:
-        unknown = [m for m in metrics if m not in _metrics.METRICS]
-        if unknown:
-            raise UnknownNameError("metric", unknown[0], _metrics.METRICS)
-        scene = _scene(p)
-        for m in metrics:                   # the scene's own metrics first: no rollout for them
-            if m in _metrics.STATIC_METRICS:
-                row[m] = metric_value(m, _metrics.METRICS[m](None, p, scene))
-        dynamic = [m for m in metrics if m not in _metrics.STATIC_METRICS]
-        r = _run_point(p, scene, dynamic, rrd_dir, row["point_id"], error_model) if dynamic or rrd_dir else None
-        if r is not None and "accuracy" in r.meta:
-            e = r.meta["accuracy"].get("error_model")
-            row["_error_model"] = None if e is None else (e["spatial_a"], e["temporal_b_per_s"])
-        for m in dynamic:
-            row[m] = metric_value(m, _metrics.METRICS[m](r, p, scene))
-        for m, est in (r.meta.get("accuracy", {}).get("metrics", {}) if r is not None else {}).items():
-            row[f"estimated_error.{m}"] = est["estimated_error"]
+        with warnings.catch_warnings():     # a study's fields are its max_field metric's (or mjeap.optimize's check)
+            warnings.simplefilter("ignore", FieldWarning)
+            _evaluate_into(row, p, metrics, rrd_dir, error_model)
     except MjeapError as e:
         row["error"] = f"{type(e).__name__}: {e}"
         if "returns" in metrics and isinstance(e, DivergenceError):
@@ -80,6 +68,26 @@ def evaluate(point: dict, metrics: Sequence[str] = ("peak_to_peak", "returns"), 
         row["error"] = f"{type(e).__name__}: {e} | {traceback.format_exc(limit=3)!r}"
     row["wall_s"] = time.perf_counter() - t0
     return row
+
+
+def _evaluate_into(row: dict, p: dict, metrics: Sequence[str], rrd_dir, error_model) -> None:
+    """The work of :func:`evaluate`: the point's scene, rollout and metrics into ``row``."""
+    unknown = [m for m in metrics if m not in _metrics.METRICS]
+    if unknown:
+        raise UnknownNameError("metric", unknown[0], _metrics.METRICS)
+    scene = _scene(p)
+    for m in metrics:                   # the scene's own metrics first: no rollout for them
+        if m in _metrics.STATIC_METRICS:
+            row[m] = metric_value(m, _metrics.METRICS[m](None, p, scene))
+    dynamic = [m for m in metrics if m not in _metrics.STATIC_METRICS]
+    r = _run_point(p, scene, dynamic, rrd_dir, row["point_id"], error_model) if dynamic or rrd_dir else None
+    if r is not None and "accuracy" in r.meta:
+        e = r.meta["accuracy"].get("error_model")
+        row["_error_model"] = None if e is None else (e["spatial_a"], e["temporal_b_per_s"])
+    for m in dynamic:
+        row[m] = metric_value(m, _metrics.METRICS[m](r, p, scene))
+    for m, est in (r.meta.get("accuracy", {}).get("metrics", {}) if r is not None else {}).items():
+        row[f"estimated_error.{m}"] = est["estimated_error"]
 
 
 def _run_point(p: dict, scene, metrics: Sequence[str], rrd_dir, pid: str, error_model=None):
