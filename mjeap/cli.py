@@ -303,6 +303,46 @@ def cmd_validate(args) -> int:
     return 1 if failed else 0
 
 
+#: where mjeap frf writes frf.csv, frf.json and frf.png unless told (--out)
+FRF_OUT = "out/frf"
+
+
+def _report_extra() -> bool:
+    import importlib.util
+    return importlib.util.find_spec("matplotlib") is not None
+
+
+def cmd_frf(args) -> int:
+    """Small-signal frequency response: frf.csv, frf.json (what was computed, how) and, with
+    the report extra, frf.png, all in --out; checked before any work."""
+    from .analysis import frf
+    from .io.outputs import check_outputs, replacing
+    f0, f1, n = frf._check_sweep(args.start, args.stop, args.points)
+    folder = Path(args.out or FRF_OUT)
+    if folder.exists() and not folder.is_dir():
+        raise ParameterError("--out", str(folder), "a folder for frf.csv, frf.json and frf.png", "it is a file")
+    paths = {"--out (frf.csv)": folder / "frf.csv", "--out (frf.json)": folder / "frf.json"}
+    plot = _report_extra()
+    if plot:
+        paths["--out (frf.png)"] = folder / "frf.png"
+    check_outputs(**paths)
+    scene = _scene_from_args(args)
+    r = frf.frequency_response(scene, f0, f1, n, offset=args.offset, drive=args.drive, drive_params=_params(args.param))
+    out = r.summary()
+    out["files"] = {"csv": str(paths["--out (frf.csv)"]), "json": str(paths["--out (frf.json)"]),
+                    "png": str(folder / "frf.png") if plot else "not written: the report extra (matplotlib) is not "
+                                                                 "installed (pip install 'mjeap[report]')"}
+    frf.write_frf(r, paths["--out (frf.csv)"])
+    with replacing(paths["--out (frf.json)"], "--out (frf.json)") as tmp:
+        tmp.write_text(json.dumps(out, indent=2, default=float), encoding="utf-8")
+    if plot:
+        frf.plot_frf(r, folder / "frf.png")
+    if r.admittance is None:
+        print(f"mjeap frf: admittance columns left empty: {r.admittance_reason}", file=sys.stderr)
+    print(json.dumps(out, indent=2, default=float))
+    return 0
+
+
 #: where mjeap identify writes the identified actuator file unless told (--out)
 IDENTIFIED = "out/identified.toml"
 
@@ -664,6 +704,19 @@ def build_parser() -> argparse.ArgumentParser:
                    help="folder for result.json, evaluations.csv (a rerun reads it as a cache) and optimum.toml")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_optimize)
+    p = sub.add_parser("frf", help="small-signal frequency response (tip deflection and admittance per volt) from "
+                       "the linearised model; resonance, antiresonance, effective coupling")
+    add_scene_args(p)
+    p.add_argument("--from", dest="start", required=True, help="lowest frequency, Hz or with a unit: 200Hz, 0.2kHz")
+    p.add_argument("--to", dest="stop", required=True, help="highest frequency (Hz or with a unit), up to the model's "
+                   "highest resolved mode and its step's Nyquist limit")
+    p.add_argument("--points", default=200, help="log-spaced frequencies (>= 2; default 200)")
+    p.add_argument("--offset", type=float, default=None, help="operating voltage of the drive's input (V; default the "
+                   "drive's rest voltage, V_bias/2 for piezo-bimorph)")
+    p.add_argument("--drive", help="drive name (default: the actuator's own)")
+    p.add_argument("--param", action="append", metavar="KEY=VALUE", help="drive parameter (repeatable)")
+    p.add_argument("--out", help=f"folder for frf.csv, frf.json and frf.png (default {FRF_OUT})")
+    p.set_defaults(func=cmd_frf)
     p = sub.add_parser("identify", help="fit the papers' models to measured data (CSV with a header)")
     isub = p.add_subparsers(dest="what", required=True)
     q = isub.add_parser("step", help="seed 000: transfer function from a curvature step response")

@@ -212,6 +212,19 @@ class PiezoBimorphDrive(OpenLoop, NativeForm, Drive):
                 "current_capacitive (A)": i_c, "current_motional (A)": i_m,
                 "drive_moment_root (N m)": float(self._m[0])}
 
+    def small_signal(self, operating_voltage: float):
+        """Linear in V_sig at any operating point: moment per volt Gamma_j = f31 w_j (t_p +
+        t_cf) per hinge, the resistive current's 1/R per volt of V_sig (d/dV_sig of (2 V_sig -
+        V_bias) / (2 R)), the dielectric capacitance C and the motional coupling Gamma_j (the
+        module text: the same coefficient by reciprocity)."""
+        from .small_signal import SmallSignal
+        v0 = self._operating_voltage(operating_voltage)
+        g = np.array(self.gamma, dtype=float)
+        return SmallSignal(v0, "V_sig", g, conductance=1.0 / self.params["resistance"],
+                           capacitance=float(self.params["capacitance"]), coupling=g,
+                           notes="Gamma_j = f31 w_j (t_p + t_cf) N m/V per hinge; I = V/R + C dV/dt + "
+                                 "sum_j Gamma_j dtheta_j/dt per volt of V_sig")
+
     # ---- Wood / Jafferis closed forms (mjeap.model.analytical), at this drive's V_eff -------------
     def bending_stiffness_per_width(self) -> float:
         sec = self.scene.actuator.section_at(0.0)
