@@ -263,15 +263,14 @@ def frequency_response(actuator, start, stop, points: int = 200, *, offset: Opti
 
 # ---------------------------------------------------------------- outputs
 def write_frf(result: FrequencyResponse, csv_path) -> None:
-    """frf.csv: :data:`FRF_COLUMNS`, the admittance cells empty (and the reason in a
-    comment line before the header) where the drive draws no current; written whole or not
-    at all (:func:`mjeap.io.outputs.replacing`)."""
+    """frf.csv: :data:`FRF_COLUMNS`, the admittance cells empty where the drive's model
+    draws no current (the reason is in :meth:`FrequencyResponse.summary`, which ``mjeap
+    frf`` writes to frf.json); written whole or not at all
+    (:func:`mjeap.io.outputs.replacing`)."""
     from ..io import csvio
     from ..io.outputs import replacing
     with replacing(csv_path, "--out (frf.csv)") as tmp:
         with open(tmp, "w", newline="", encoding="utf-8") as fh:
-            if result.admittance is None:
-                fh.write(f"# admittance not computed: {result.admittance_reason}\n")
             w = csvio.writer(fh)
             w.writerow(FRF_COLUMNS)
             w.writerows(result.rows())
