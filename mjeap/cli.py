@@ -376,9 +376,11 @@ def _write_identified(act, out: str) -> str:
 
 def cmd_identify_step(args) -> int:
     from .analysis.identify import fit_step_response, given_rows, read_columns, step_actuator, step_rows
+    from .analysis.identify import check_identification
     act = given = None
     if args.actuator is not None:       # the file to put the fit in: checked before any work
         act = _actuator(args.actuator)
+        check_identification(act, "step")
         given = given_rows(_params(args.param), "mjeap identify step")
         step_rows(act, given)
         out_path = _identified_out(args, act)
@@ -387,7 +389,8 @@ def cmd_identify_step(args) -> int:
             if v is not None:
                 raise ParameterError(flag, v if flag == "--out" else " ".join(v),
                                      f"{flag} only with --actuator (the actuator file the identified parameters go in)")
-    d = read_columns(args.file, [args.time_column, args.curvature_column])
+    d = read_columns(args.file, [args.time_column, args.curvature_column],
+                     units={args.time_column: "s", args.curvature_column: "1/m"})
     fit = fit_step_response(d[args.time_column], d[args.curvature_column], args.voltage, args.t_step)
     out = {"fit": "kappa(t) = A + B exp(-p t) + C exp(-a t)", "A_per_m": fit.A, "B_per_m": fit.B, "C_per_m": fit.C,
            "transfer_function": f"K/V = {fit.gain:.4g} (s + {fit.zero:.4g}) / ((s + {fit.pole_mechanical:.4g})"
@@ -404,34 +407,40 @@ def cmd_identify_step(args) -> int:
 
 
 def cmd_identify_hinges(args) -> int:
-    from .analysis import identify as ident
+    """The beam's stiffness scale (EI(x) kept proportional to the file's), mass scale and
+    damping ratio fitted to a tip trajectory with the file's own model
+    (:mod:`mjeap.analysis.file_fit`); the identified file is the model that was fitted."""
+    from .analysis import file_fit, identify as ident
     scene = _scene_from_args(args)
     params = _params(args.param)
     given = ident.given_rows(params, "mjeap identify hinges")
     ident.file_drive_rows(scene.actuator, args.drive, given)        # checked before the fit, as is --out
     out_path = _identified_out(args, scene.actuator)
-    d = ident.read_columns(args.file, [args.time_column, args.tip_column])
+    d = ident.read_columns(args.file, [args.time_column, args.tip_column],
+                           units={args.time_column: "s", args.tip_column: "m"})
     t, y = d[args.time_column], d[args.tip_column]
-    fit = ident.fit_hinge_parameters(scene, t, y, args.voltage, drive=args.drive, drive_params=params)
-    out = {"stiffness_N_m_per_rad": fit.stiffness, "stiffness_std": fit.stiffness_std,
-           "damping_N_m_s_per_rad": fit.damping, "damping_std": fit.damping_std,
-           "rms_residual_m": fit.rms_residual, "simulations": fit.evaluations,
-           "segments": scene.layout.segments}
-    act = ident.hinge_actuator(scene, fit, args.file, drive=args.drive, given=given)
-    err, swing = ident.reproduction_error(scene, fit, act, t, args.voltage, args.drive, params)
-    out.update(flexural_rigidity_N_m2=act.flexural_rigidity.value, damping_ratio=act.damping_ratio.value,
-               identified_file_rms_m=err)
-    if not err <= ident.REPRODUCE * swing:
-        print(json.dumps(out, indent=2))
-        raise ParameterError("identified actuator", f"{act.id} off the fitted trajectory by {err:.3g} m rms "
-                             f"({err / swing:.1%} of its swing)", f"a file that reproduces the fit within "
-                             f"{ident.REPRODUCE:.0%} of the swing", f"the file's EI and damping ratio do not give the "
-                             f"fitted hinges under the {act.drive} drive: a drive whose moment scales with EI (rc-"
-                             "relaxation's gain is a curvature per volt) cannot carry a hinge stiffness, identify it "
-                             f"with mjeap identify step; nothing written to {out_path}")
+    fit = file_fit.fit_tip_trajectory(scene, t, y, args.voltage, drive=args.drive, drive_params=params)
+    act = file_fit.trajectory_actuator(scene, fit, args.file, drive=args.drive, given=given)
+    EI = act.flexural_rigidity_at([0.0, act.length])
+    out = {**fit.as_dict(), "rms_residual_m": fit.rms_residual, "residual_fraction": fit.rms_residual / fit.swing,
+           "simulations": fit.evaluations, "segments": scene.layout.segments,
+           "flexural_rigidity_clamp_N_m2": float(EI[0]), "flexural_rigidity_tip_N_m2": float(EI[1]),
+           "mass_kg": act.total_mass(), "first_frequency_hz": file_fit_f1(scene, act)}
+    warning = file_fit.check_residual(fit.rms_residual, fit.swing, "identified actuator",
+                                      f"nothing written to {out_path}")
+    out["identified_file_rms_m"] = fit.rms_residual
+    if warning:
+        out["warning"] = warning
+        print(f"mjeap: warning: {warning}", file=sys.stderr)
     out["actuator_file"] = _write_identified(act, out_path)
-    print(json.dumps(out, indent=2))
+    print(json.dumps(out, indent=2, default=float))
     return 0
+
+
+def file_fit_f1(scene, act) -> float:
+    """The first mode (Hz) of ``act`` built as ``scene`` is."""
+    from .analysis.identify import _scene_like
+    return float(_scene_like(scene, act).choice.first_frequency)
 
 
 #: how a command's actuator argument reads
