@@ -443,6 +443,57 @@ def file_fit_f1(scene, act) -> float:
     return float(_scene_like(scene, act).choice.first_frequency)
 
 
+def cmd_identify_piezo(args) -> int:
+    """A piezo bender's coupling, stiffness or tip mass, damping ratio, capacitance and
+    resistance fitted to stroke, tip-FRF and impedance data (or a published resonance) with
+    the file's own small-signal model (:mod:`mjeap.analysis.piezo_fit`)."""
+    from .analysis import file_fit, identify as ident, piezo_fit as pf
+    from .analysis.frf import parse_frequency
+    if not any((args.stroke, args.frf, args.impedance, args.resonance)):
+        raise ParameterError("identify piezo", "no measurement", "at least one of --stroke, --frf, --impedance "
+                             "(CSV files) or --resonance (a published first resonance, e.g. 1750Hz)")
+    resonance = None if args.resonance is None else parse_frequency(args.resonance, "--resonance")
+    scene = _scene_from_args(args)
+    ident.check_identification(scene.actuator, "piezo")
+    given = ident.given_rows(_params(args.param), "mjeap identify piezo")
+    ident.file_drive_rows(scene.actuator, None, given)
+    out_path = _identified_out(args, scene.actuator)
+    data = pf.PiezoData(
+        stroke=None if args.stroke is None else pf.read_stroke(args.stroke, args.voltage_column, args.stroke_column),
+        frf=None if args.frf is None else pf.read_frf(args.frf),
+        impedance=None if args.impedance is None else (*pf.read_impedance(args.impedance), args.impedance_state),
+        resonance=resonance,
+        sources={"stroke": args.stroke, "frf": args.frf,
+                 "impedance": f"{args.impedance} ({args.impedance_state} actuator)" if args.impedance else None,
+                 "resonance": f"{args.resonance} (given: --resonance)"})
+    fit = pf.fit_piezo(scene, data)
+    act = pf.piezo_actuator(scene, fit, data, given)
+    out = {"identified": {k: {"factor" if k != "damping_ratio" else "value": v, "std": fit.std[k]}
+                          for k, v in fit.values.items()},
+           "held": fit.held, "rms_residuals": fit.residuals, "derived": fit.derived, "evaluations": fit.evaluations}
+    name = pf.COUPLING_PARAMETER[act.drive]
+    out["file"] = {k: {"value": r[0], "source": r[2]} for k, r in act.drive_parameters.items()
+                   if k in (name, "capacitance", "resistance")}
+    out["file"].update({"damping_ratio": {"value": act.damping_ratio.value, "source": act.damping_ratio.source},
+                        "tip_block_mass_kg": {"value": act.planform.tip_block_mass,
+                                              "source": act.planform.residual_source},
+                        "flexural_rigidity_clamp_N_m2": {"value": float(act.flexural_rigidity_at(0.0)[0]),
+                                                         "source": act.layers[0].provenance("youngs_modulus")}})
+    worst = max(fit.residuals, key=fit.residuals.get)
+    warning = file_fit.check_residual(fit.residuals[worst], 1.0, f"identify piezo ({worst})",
+                                      f"nothing written to {out_path}")
+    if warning:
+        out["warning"] = f"{worst}: {warning}"
+        print(f"mjeap: warning: {worst}: {warning}", file=sys.stderr)
+    for k, why in fit.held.items():
+        if k in ("stiffness", "tip_mass") and any(q in fit.values for q in ("stiffness", "tip_mass")):
+            print(f"mjeap identify piezo: f1 fitted by the {'tip block mass' if k == 'stiffness' else 'modulus scale'}:"
+                  f" {k} {why}", file=sys.stderr)
+    out["actuator_file"] = _write_identified(act, out_path)
+    print(json.dumps(out, indent=2, default=float))
+    return 0
+
+
 #: how a command's actuator argument reads
 ACTUATOR_HELP = ("catalog id (mjeap list) or actuator file: a name ending in .toml or holding a path separator "
                  "is a file (./NAME for a file named like an id)")
@@ -751,6 +802,24 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--out", help=f"the identified actuator file: the actuator with EI = k L/N and the damping ratio "
                    f"of the fitted joints (default {IDENTIFIED})")
     q.set_defaults(func=cmd_identify_hinges)
+    q = isub.add_parser("piezo", help="a piezo bender's coupling (f31), stiffness or tip mass, damping ratio, "
+                        "capacitance and resistance from stroke, tip-FRF and impedance data")
+    add_scene_args(q)
+    q.add_argument("--stroke", help="CSV of stroke against voltage: columns voltage (V_sig) and stroke (tip "
+                   "deflection), units in the headers")
+    q.add_argument("--voltage-column", default="voltage")
+    q.add_argument("--stroke-column", default="stroke")
+    q.add_argument("--frf", help="CSV of the tip's frequency response per volt: frequency, tip_per_volt [, tip_phase "
+                   "(deg)], as mjeap frf writes them")
+    q.add_argument("--impedance", help="CSV of an impedance sweep: frequency and admittance [, admittance_phase], "
+                   "impedance [, impedance_phase] or capacitance [, resistance]")
+    q.add_argument("--impedance-state", choices=("free", "fixed"), default="free",
+                   help="free: the actuator could move (the motional current is in the data); fixed: blocked, as "
+                        "Jayaram et al. 2018 fixed theirs in epoxy (the data hold C and R only)")
+    q.add_argument("--resonance", help="a published first resonance (Hz or with a unit), where no sweep is at hand")
+    q.add_argument("--param", action="append", metavar="KEY=VALUE", help="drive parameter kept as given (repeatable)")
+    q.add_argument("--out", help=f"the identified actuator file (default {IDENTIFIED})")
+    q.set_defaults(func=cmd_identify_piezo)
     return ap
 
 
