@@ -18,7 +18,7 @@ LAYER_FILES = {
     "engines": ("test_threaded", "test_native", "test_warp"),
     "simulation": ("test_rollout", "test_system", "test_pipeline", "test_accuracy", "test_periodic", "test_golden",
                    "test_viewer"),
-    "analysis": ("test_identify", "test_self_sensing", "test_stability_map", "test_frf"),
+    "analysis": ("test_identify", "test_self_sensing", "test_stability_map", "test_frf", "test_identify_piezo"),
     "applications": ("test_sweep", "test_metric_accuracy", "test_design_sweeps", "test_optimize", "test_actuator_cli",
                      "test_validation",
                      "test_controllers", "test_hamr_leg", "test_environment", "test_gymnasium_env"),
