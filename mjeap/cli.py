@@ -317,7 +317,7 @@ def cmd_frf(args) -> int:
     the report extra, frf.png, all in --out; checked before any work."""
     from .analysis import frf
     from .io.outputs import check_outputs, replacing
-    f0, f1, n = frf._check_sweep(args.start, args.stop, args.points)
+    f0, f1, n = frf.check_sweep(args.start, args.stop, args.points)
     folder = Path(args.out or FRF_OUT)
     if folder.exists() and not folder.is_dir():
         raise ParameterError("--out", str(folder), "a folder for frf.csv, frf.json and frf.png", "it is a file")

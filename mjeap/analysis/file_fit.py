@@ -9,11 +9,9 @@ identified file is the model that was fitted (``mjeap identify hinges``, ``ident
   proportional to the file's); the tip block is kept.
 * The damping is the file's first-mode damping ratio (Rayleigh damping beta K in the beam).
 
-Every fitted number's uncertainty is the least-squares covariance (J^T J)^-1 s^2 scaled for
-correlated residuals: a model that misses the data leaves a smooth residual, whose lag-one
-autocorrelation rho leaves (1 - rho) / (1 + rho) as many independent samples as there are
-samples (the AR(1) effective sample size), so the variance is multiplied by
-(1 + rho) / (1 - rho). White noise leaves it as it is; a smooth misfit widens it.
+Every fitted number's uncertainty is the least-squares covariance scaled for correlated
+residuals (:func:`mjeap.analysis.identify.covariance`): a smooth misfit widens it, white noise
+leaves it as it is.
 """
 from __future__ import annotations
 
@@ -26,7 +24,7 @@ from scipy import optimize
 
 from ..errors import ParameterError
 
-__all__ = ["ScaleFit", "scaled_actuator", "covariance", "check_residual", "fit_tip_trajectory", "trajectory_actuator",
+__all__ = ["ScaleFit", "scaled_actuator", "check_residual", "fit_tip_trajectory", "trajectory_actuator",
            "RESIDUAL_WARNING", "RESIDUAL_LIMIT"]
 
 #: a fit whose rms residual exceeds this fraction of the data's swing is told loudly
@@ -38,26 +36,6 @@ UNRESOLVED = 0.25
 #: ... or whose change by a factor e moves the fitted trajectory by less than this fraction of
 #: its swing (a model error could then set it)
 SENSITIVITY = 0.05
-#: the highest lag-one autocorrelation counted (a residual of one smooth hump)
-RHO_MAX = 0.995
-
-
-def covariance(jac: np.ndarray, residual: np.ndarray) -> Tuple[np.ndarray, float]:
-    """(covariance of the parameters, the variance inflation (1 + rho) / (1 - rho)) of a least
-    squares fit with Jacobian ``jac`` at residual ``residual`` (module text): s^2 (J^T J)^-1
-    with s^2 = |r|^2 / (n - p), inf where J^T J is singular."""
-    n, p = jac.shape
-    r = np.asarray(residual, float)
-    s2 = float(r @ r) / max(n - p, 1)
-    rho = float(np.clip((r[:-1] @ r[1:]) / (r @ r), 0.0, RHO_MAX)) if r @ r > 0 and n > 2 else 0.0
-    inflation = (1 + rho) / (1 - rho)
-    try:
-        jtj = jac.T @ jac
-        if np.linalg.cond(jtj) > 1e14:
-            raise np.linalg.LinAlgError
-        return np.linalg.inv(jtj) * s2 * inflation, inflation
-    except np.linalg.LinAlgError:
-        return np.full((p, p), np.inf), inflation
 
 
 def check_residual(rms: float, swing: float, what: str, nothing_written: str = "") -> Optional[str]:
@@ -144,7 +122,7 @@ def fit_tip_trajectory(scene, time, tip, voltage, drive=None, drive_params: Opti
     determine (relative 1-sigma above UNRESOLVED, or a factor e on it moving the trajectory
     by less than SENSITIVITY of its swing: the mass of a quasi-static record, the damping of
     one without ringing) is held at the file's and the reason noted."""
-    from .identify import _scene_like, check_series
+    from .identify import _scene_like, check_series, covariance
     from ..simulation.rollout import rollout
     t, y = check_series(time, tip, names=["tip_deflection"])
     swing = float(np.ptp(y))

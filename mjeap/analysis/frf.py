@@ -33,7 +33,7 @@ from scipy import optimize
 
 from ..errors import ParameterError, check_integer, check_positive
 
-__all__ = ["FrequencyResponse", "SmallSignalModel", "frequency_response", "parse_frequency", "sweep_limit",
+__all__ = ["FrequencyResponse", "SmallSignalModel", "frequency_response", "parse_frequency", "check_sweep", "sweep_limit",
            "write_frf", "plot_frf", "FRF_COLUMNS"]
 
 #: the columns of frf.csv
@@ -102,7 +102,7 @@ class SmallSignalModel:
     def carries_current(self) -> bool:
         return self.small_signal.current
 
-    def _solve(self, f: float):
+    def solve(self, f: float):
         """(dofs q, drive states x) per volt at ``f`` Hz (q internal, x SI)."""
         ss, u = self.small_signal, self.units
         s = 2j * np.pi * f
@@ -125,7 +125,7 @@ class SmallSignalModel:
         ss = self.small_signal
         tip, y = np.empty(f.size, complex), np.empty(f.size, complex)
         for i, fi in enumerate(f):
-            q, x = self._solve(fi)
+            q, x = self.solve(fi)
             s = 2j * np.pi * fi
             tip[i] = self.tip_row @ q
             y[i] = ss.conductance + s * ss.capacitance + s * (ss.coupling @ (self.P.T @ q)) + ss.current_from_state @ x
@@ -220,7 +220,9 @@ class FrequencyResponse:
                 "quasi_static_tip_per_volt_m_per_v": float(abs(self.tip_per_volt[0]))}
 
 
-def _check_sweep(start, stop, points):
+def check_sweep(start, stop, points) -> tuple:
+    """(start Hz, stop Hz, points) checked: frequencies in Hz or with a unit, start below stop,
+    at least two points; a ParameterError naming --from, --to or --points."""
     f0, f1 = parse_frequency(start, "--from"), parse_frequency(stop, "--to")
     n = check_integer("--points", points, 2, MAX_POINTS, "a sweep needs at least two frequencies")
     if not f0 < f1:
@@ -238,7 +240,7 @@ def frequency_response(actuator, start, stop, points: int = 200, *, offset: Opti
     work: ``start`` not below ``stop``, fewer than 2 points, ``stop`` above the model's
     highest resolved mode or its step's Nyquist limit (:func:`sweep_limit`)."""
     from ..simulation.scene import Scene
-    f0, f1, n = _check_sweep(start, stop, points)
+    f0, f1, n = check_sweep(start, stop, points)
     scene = actuator if isinstance(actuator, Scene) else Scene(actuator, **scene_args)
     if scene_args and isinstance(actuator, Scene):
         raise ParameterError("scene arguments", ", ".join(scene_args), "none with a built Scene (they build one)")

@@ -104,6 +104,31 @@ def read_columns(path: Union[str, Path], columns: Sequence[str], min_samples: in
     return data
 
 
+#: the highest lag-one autocorrelation counted (a residual of one smooth hump)
+RHO_MAX = 0.995
+
+
+def covariance(jac: np.ndarray, residual: np.ndarray) -> Tuple[np.ndarray, float]:
+    """(covariance of the parameters, the variance inflation) of a least-squares fit with
+    Jacobian ``jac`` at residual ``residual``: s^2 (J^T J)^-1 with s^2 = |r|^2 / (n - p),
+    scaled for correlated residuals. A model that misses the data leaves a smooth residual,
+    whose lag-one autocorrelation rho leaves (1 - rho) / (1 + rho) as many independent samples
+    as there are samples (the AR(1) effective sample size), so the variance is multiplied by
+    (1 + rho) / (1 - rho); white noise leaves it as it is. inf where J^T J is singular."""
+    n, p = jac.shape
+    r = np.asarray(residual, float)
+    s2 = float(r @ r) / max(n - p, 1)
+    rho = float(np.clip((r[:-1] @ r[1:]) / (r @ r), 0.0, RHO_MAX)) if r @ r > 0 and n > 2 else 0.0
+    inflation = (1 + rho) / (1 - rho)
+    try:
+        jtj = jac.T @ jac
+        if np.linalg.cond(jtj) > 1e14:
+            raise np.linalg.LinAlgError
+        return np.linalg.inv(jtj) * s2 * inflation, inflation
+    except np.linalg.LinAlgError:
+        return np.full((p, p), np.inf), inflation
+
+
 # ---------------------------------------------------------------- seed 000: step response
 @dataclass(frozen=True)
 class StepFit:
@@ -204,7 +229,7 @@ def _step_fit(model, best, t, voltage) -> "StepFit":
 class HingeFit:
     stiffness: float             # N m / rad, every hinge
     damping: float               # N m s / rad, every hinge
-    stiffness_std: float         # 1-sigma, the residual's correlation counted (mjeap.analysis.file_fit.covariance)
+    stiffness_std: float         # 1-sigma, the residual's correlation counted (covariance)
     damping_std: float
     rms_residual: float          # m
     evaluations: int
@@ -245,7 +270,6 @@ def fit_hinge_parameters(scene, time, tip_deflection, voltage, drive=None, drive
 
     res = optimize.least_squares(residual, [np.log(k0), np.log(b0)], diff_step=1e-4, x_scale=1.0,
                                  xtol=1e-10, ftol=1e-10, max_nfev=200)
-    from .file_fit import covariance
     k, b = np.exp(res.x)
     cov, _ = covariance(res.jac, res.fun)           # scaled for correlated residuals (model error)
     sk, sb = np.sqrt(np.diag(cov))

@@ -24,7 +24,7 @@ combination the data do not see) or whose factor e moves the fit by less than
 
 Residuals: the stroke's about a fitted offset, relative to its swing; the FRF's and the
 admittance's magnitudes as log ratios and their phases in radians; a given resonance relative.
-Uncertainties: :func:`mjeap.analysis.file_fit.covariance` (residual correlation counted); none
+Uncertainties: :func:`mjeap.analysis.identify.covariance` (residual correlation counted); none
 where the data are exactly as many as the parameters they fix (then the measurement's own
 uncertainty carries over).
 """
@@ -254,7 +254,8 @@ def fit_piezo(scene, data: PiezoData) -> PiezoFit:
     """Fit the parameters the measurements ``data`` determine (module text) with the model of
     ``scene`` (its actuator file built as the user asked), by scipy.optimize.least_squares on
     their logarithms; held ones are named with the reason."""
-    from .file_fit import SENSITIVITY, UNRESOLVED, covariance
+    from .file_fit import SENSITIVITY, UNRESOLVED
+    from .identify import covariance
     if not data.given():
         raise ParameterError("identify piezo", "no measurement", "at least one of --stroke, --frf, --impedance "
                              "or --resonance")
@@ -338,7 +339,7 @@ def _derived(model: _Model) -> Dict[str, float]:
         out["antiresonance_frequency_hz"] = fa
         out["coupling_factor"] = float(np.sqrt(max(0.0, 1 - (fr / fa) ** 2)))
     f = f1 / 100
-    q, _ = m._solve(f)
+    q, _ = m.solve(f)
     ss = m.small_signal
     out["quasi_static_tip_per_volt_m_per_v"] = float(abs(m.tip_row @ q))
     motional = float(np.real(ss.coupling @ (m.P.T @ q)))
