@@ -392,6 +392,9 @@ def cmd_identify_step(args) -> int:
     d = read_columns(args.file, [args.time_column, args.curvature_column],
                      units={args.time_column: "s", args.curvature_column: "1/m"})
     fit = fit_step_response(d[args.time_column], d[args.curvature_column], args.voltage, args.t_step)
+    from .analysis.file_fit import check_residual
+    warning = check_residual(fit.rms_residual, float(np.ptp(d[args.curvature_column])), "identify step",
+                             "nothing written" if act is None else f"nothing written to {out_path}")
     out = {"fit": "kappa(t) = A + B exp(-p t) + C exp(-a t)", "A_per_m": fit.A, "B_per_m": fit.B, "C_per_m": fit.C,
            "transfer_function": f"K/V = {fit.gain:.4g} (s + {fit.zero:.4g}) / ((s + {fit.pole_mechanical:.4g})"
                                 f"(s + {fit.pole_electrical:.4g}))",
@@ -399,6 +402,9 @@ def cmd_identify_step(args) -> int:
            "drive": "rc-relaxation", "drive_parameters": fit.drive_parameters(),
            "use": "mjeap rollout ACTUATOR --drive rc-relaxation " +
                   " ".join(f"--param {k}={v:.6g}" for k, v in fit.drive_parameters().items())}
+    if warning:
+        out["warning"] = warning
+        print(f"mjeap: warning: {warning}", file=sys.stderr)
     if act is not None:
         out["actuator_file"] = _write_identified(step_actuator(act, fit, args.file, given), out_path)
         out["use"] = f"mjeap rollout {out_path} --voltage step:{args.voltage:g}V --duration ..."
@@ -727,7 +733,8 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--metrics", default="peak_to_peak,returns",
                    help="comma list: peak_to_peak, returns, settling_time, max_stress_proxy, max_tip_deflection, "
                         "first_frequency, mass, free_deflection, blocked_force, energy_density, peak_power, "
-                        "energy_per_cycle")
+                        "energy_per_cycle, resonance_frequency, antiresonance_frequency, coupling_factor, "
+                        "tip_per_volt_at")
     p.add_argument("--out", default="out/sweep.csv", help="results CSV (appended; finished points are skipped)")
     from .sweep import EXECUTORS
     p.add_argument("--executor", choices=EXECUTORS, default="processes")
