@@ -33,6 +33,8 @@ __all__ = ["CATALOG", "Actuator", "Layer", "Planform", "get_actuator", "actuator
 
 from .optimize import optimize  # noqa: E402  (design optimisation, mjeap.optimize)
 __all__.append("optimize")
+from .analysis.frf import frequency_response  # noqa: E402  (small-signal response, mjeap frf)
+__all__.append("frequency_response")
 
 import importlib.util as _util  # noqa: E402
 

@@ -237,3 +237,48 @@ def test_the_rod_is_refused_with_the_reason():
         pytest.skip(BUILDERS["rod"].unavailable_reason())
     with pytest.raises(ParameterError, match="rod"):
         frequency_response("pzt-hamr-small", 100.0, 1000.0, 5, representation="rod")
+
+
+def test_a_drive_of_ones_own_plugs_in_and_a_bad_model_is_named():
+    """A user drive that states a uniform moment per volt is answered like the built-in ones
+    (the quasi-static tip of a uniform moment, Gamma L^2 / (2 EI), 1 %); one whose
+    small_signal returns something else is refused naming the drive; one without is refused
+    naming it too."""
+    from mjeap.drives import Drive, SmallSignal, register_drive, DRIVES
+
+    class Plain(Drive):
+        name = "test-plain-moment"
+        GENERIC_PARAMETERS = {"gain": (1e-6, "N m/V", "test")}
+
+        def step(self, voltage, dt):
+            self.part.set_internal_moments(self.params["gain"] * voltage)
+
+        def small_signal(self, operating_voltage):
+            return SmallSignal(operating_voltage, "V", np.full(self.scene.layout.segments, self.params["gain"]),
+                               current=False, no_current="test drive")
+
+    class Broken(Plain):
+        name = "test-broken-moment"
+
+        def small_signal(self, operating_voltage):
+            return {"moment_per_volt": 1.0}
+
+    class Silent(Plain):
+        name = "test-silent-moment"
+        small_signal = Drive.small_signal
+
+    try:
+        for cls in (Plain, Broken, Silent):
+            register_drive(cls)
+        act = uniform_bimorph()
+        s = Scene(act, gravity=False)
+        EI, _, _ = closed_forms(act)
+        r = frequency_response(s, 1.0, 2.0, 2, drive="test-plain-moment")
+        assert abs(r.tip_per_volt[0]) == pytest.approx(1e-6 * act.length ** 2 / (2 * EI), rel=0.01)
+        with pytest.raises(ParameterError, match="test-broken-moment"):
+            frequency_response(s, 1.0, 2.0, 2, drive="test-broken-moment")
+        with pytest.raises(ParameterError, match="test-silent-moment.*states none"):
+            frequency_response(s, 1.0, 2.0, 2, drive="test-silent-moment")
+    finally:
+        for name in ("test-plain-moment", "test-broken-moment", "test-silent-moment"):
+            DRIVES.pop(name, None)

@@ -69,8 +69,12 @@ class SmallSignalModel:
         self.scene = scene
         self.drive = drive if isinstance(drive, Drive) else make_drive(drive, scene, **(drive_params or {}))
         v0 = self.drive.rest_voltage() if operating_voltage is None else float(operating_voltage)
+        from ..drives.small_signal import SmallSignal
         self.small_signal = ss = self.drive.small_signal(v0)
         u, lin, n = scene.units, scene.linearization, scene.layout.segments
+        if not isinstance(ss, SmallSignal) or ss.moment_per_volt.shape != (n,):
+            raise ParameterError(f"drive {self.drive.name}", type(ss).__name__, f"a small_signal() that returns a "
+                                 f"mjeap.drives.SmallSignal with one moment per volt for each of the {n} hinges")
         self.units = u
         self.M, self.K = lin.M, lin.K
         beta = scene.choice.rayleigh_beta / u.time
