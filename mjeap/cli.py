@@ -472,7 +472,7 @@ def cmd_identify_piezo(args) -> int:
         sources={"stroke": args.stroke, "frf": args.frf,
                  "impedance": f"{args.impedance} ({args.impedance_state} actuator)" if args.impedance else None,
                  "resonance": f"{args.resonance} (given: --resonance)"})
-    fit = pf.fit_piezo(scene, data)
+    fit = pf.fit_piezo(scene, data, drive_params=_params(args.param))
     act = pf.piezo_actuator(scene, fit, data, given)
     out = {"identified": {k: {"factor" if k != "damping_ratio" else "value": v, "std": fit.std[k]}
                           for k, v in fit.values.items()},
@@ -486,7 +486,7 @@ def cmd_identify_piezo(args) -> int:
                         "flexural_rigidity_clamp_N_m2": {"value": float(act.flexural_rigidity_at(0.0)[0]),
                                                          "source": act.layers[0].provenance("youngs_modulus")}})
     worst = max(fit.residuals, key=fit.residuals.get)
-    warning = file_fit.check_residual(fit.residuals[worst], 1.0, f"identify piezo ({worst})",
+    warning = file_fit.check_residual(fit.residuals[worst], None, f"identify piezo ({worst})",
                                       f"nothing written to {out_path}")
     if warning:
         out["warning"] = f"{worst}: {warning}"

@@ -151,3 +151,14 @@ def test_refusals_before_any_work(tmp_path, capsys):
     assert not out.exists()
     with pytest.raises(ParameterError, match="at least one"):
         fit_piezo(Scene("pzt-hamr-small"), PiezoData())
+
+
+def test_a_coupling_given_on_the_command_line_is_kept():
+    """--param f31=... keeps f31 as given: the coupling is not fitted, the FRF then fits the
+    stiffness to the quasi-static gain (Gamma / EI with Gamma as given)."""
+    t = truth()
+    r = frequency_response(Scene(t), 300.0, 3000.0, 40)
+    fit = fit_piezo(Scene(perturbed(t)), PiezoData(frf=(r.frequency, r.tip_per_volt, True)),
+                    drive_params={"f31": 32.0})
+    assert "coupling" not in fit.values and "given on the command line" in fit.held["coupling"]
+    assert fit.values["stiffness"] == pytest.approx(1 / 0.9, rel=0.01)

@@ -38,12 +38,15 @@ UNRESOLVED = 0.25
 SENSITIVITY = 0.05
 
 
-def check_residual(rms: float, swing: float, what: str, nothing_written: str = "") -> Optional[str]:
+def check_residual(rms: float, swing: Optional[float], what: str, nothing_written: str = "") -> Optional[str]:
     """None where the fit's ``rms`` residual is within RESIDUAL_WARNING of the data's
-    ``swing``; a warning's text up to RESIDUAL_LIMIT; beyond it a ParameterError."""
-    ratio = rms / swing if swing > 0 else np.inf
-    text = (f"the fit leaves an rms residual of {rms:.3g} ({ratio:.1%} of the data's swing {swing:.3g}): the model "
-            "does not describe the data (check the columns' units, the voltage, the drive, the scene)")
+    ``swing`` (None: ``rms`` is relative already, a log ratio); a warning's text up to
+    RESIDUAL_LIMIT; beyond it a ParameterError."""
+    ratio = rms if swing is None else (rms / swing if swing > 0 else np.inf)
+    told = f"a relative rms residual of {ratio:.1%}" if swing is None else \
+        f"an rms residual of {rms:.3g} ({ratio:.1%} of the data's swing {swing:.3g})"
+    text = (f"the fit leaves {told}: the model does not describe the data (check the columns' units, the voltage, "
+            "the drive, the scene)")
     if ratio > RESIDUAL_LIMIT:
         raise ParameterError(what, f"a residual of {ratio:.1%} of the swing",
                              f"data the identified model reproduces within {RESIDUAL_LIMIT:.0%} of its swing",

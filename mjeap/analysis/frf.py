@@ -245,9 +245,9 @@ def frequency_response(actuator, start, stop, points: int = 200, *, offset: Opti
     highest resolved mode or its step's Nyquist limit (:func:`sweep_limit`)."""
     from ..simulation.scene import Scene
     f0, f1, n = check_sweep(start, stop, points)
-    scene = actuator if isinstance(actuator, Scene) else Scene(actuator, **scene_args)
     if scene_args and isinstance(actuator, Scene):
         raise ParameterError("scene arguments", ", ".join(scene_args), "none with a built Scene (they build one)")
+    scene = actuator if isinstance(actuator, Scene) else Scene(actuator, **scene_args)
     limit, why = sweep_limit(scene)
     if f1 > limit * (1 + 1e-12):
         raise ParameterError("--to", f"{f1:g} Hz", f"a frequency up to {limit:.6g} Hz", why)

@@ -123,12 +123,11 @@ def read_impedance(path) -> Tuple[np.ndarray, np.ndarray, object]:
 class _Model:
     """The file's small-signal model with the parameters' factors applied (module text)."""
 
-    def __init__(self, scene):
-        from .file_fit import scaled_actuator
+    def __init__(self, scene, drive_params: Optional[dict] = None):
         from .frf import SmallSignalModel
         from .identify import _scene_like
         self.scene = scene
-        self.base = SmallSignalModel(scene)
+        self.base = SmallSignalModel(scene, drive_params=drive_params)
         if self.base.drive.name not in COUPLING_PARAMETER:
             raise ParameterError("drive", self.base.drive.name, f"a piezoelectric drive ({', '.join(COUPLING_PARAMETER)})")
         lin = scene.linearization
@@ -142,7 +141,6 @@ class _Model:
             self.dM, self.dKg = lin2.M - self.M0, lin2.K_gravity - self.Kg0
         else:
             self.dM = self.dKg = np.zeros_like(self.M0)
-        self._scaled = scaled_actuator
         self.ss0 = self.base.small_signal
         self.pattern = np.clip(np.diag(self.Kel), 0.0, None)
         self.u = scene.units
@@ -250,18 +248,26 @@ _HELD = {
                    "resolution)"}
 
 
-def fit_piezo(scene, data: PiezoData) -> PiezoFit:
+#: the drive parameter each fitted factor scales (the coupling's is the drive's own, COUPLING_PARAMETER)
+SCALES = {"capacitance": "capacitance", "conductance": "resistance"}
+
+
+def fit_piezo(scene, data: PiezoData, drive_params: Optional[dict] = None) -> PiezoFit:
     """Fit the parameters the measurements ``data`` determine (module text) with the model of
-    ``scene`` (its actuator file built as the user asked), by scipy.optimize.least_squares on
-    their logarithms; held ones are named with the reason."""
+    ``scene`` (its actuator file built as the user asked) and its drive with ``drive_params``
+    over the file's (those given are kept: their factors are not fitted), by
+    scipy.optimize.least_squares on their logarithms; held ones are named with the reason."""
     from .file_fit import SENSITIVITY, UNRESOLVED
     from .identify import covariance
     if not data.given():
         raise ParameterError("identify piezo", "no measurement", "at least one of --stroke, --frf, --impedance "
                              "or --resonance")
-    model = _Model(scene)
-    names = _candidates(data, model)
+    model = _Model(scene, drive_params)
+    given = {p for p, key in {**SCALES, "coupling": COUPLING_PARAMETER[model.base.drive.name]}.items()
+             if key in (drive_params or {})}
+    names = [p for p in _candidates(data, model) if p not in given]
     held = {p: _HELD[p].format(others="the tip mass") for p in PARAMETERS if p not in names}
+    held.update({p: "given on the command line (--param): kept as given" for p in given})
     z0 = scene.choice.damping_ratio
     start = {p: 0.0 for p in PARAMETERS}
     start["damping_ratio"] = np.log(z0)
@@ -382,8 +388,8 @@ def piezo_actuator(scene, fit: PiezoFit, data: PiezoData, given: Optional[Dict[s
             dataclasses.replace(p, extension_mass=total, residual_tip_mass=0.0, extension_source=src)
         new = dataclasses.replace(new, planform=plan)
     name = COUPLING_PARAMETER[drive]
-    for p, key, f in (("coupling", name, lambda x: x), ("capacitance", "capacitance", lambda x: x),
-                      ("conductance", "resistance", lambda x: 1.0 / x)):
+    for p, key, f in (("coupling", name, lambda x: x), ("capacitance", SCALES["capacitance"], lambda x: x),
+                      ("conductance", SCALES["conductance"], lambda x: 1.0 / x)):
         if p in v:
             old = rows.get(key, (cls_params[key], "", ""))[0]
             rows[key] = (float(old * f(v[p])), "", f"{how(p)}: x {f(v[p]):.6g} of {old:.6g}")
