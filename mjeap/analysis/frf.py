@@ -310,6 +310,7 @@ def plot_frf(result: FrequencyResponse, png_path) -> None:
         for a in ax[:, 1]:
             a.text(0.5, 0.5, "no admittance:\n" + _wrap(result.admittance_reason), ha="center", va="center",
                    transform=a.transAxes, fontsize=8)
+            a.set_yticks([])
     ax[0, 1].set_ylabel("admittance (S)")
     ax[1, 1].set_ylabel("admittance phase (deg)")
     for a in ax[1]:
