@@ -33,6 +33,8 @@ __all__ = ["CATALOG", "Actuator", "Layer", "Planform", "get_actuator", "actuator
 
 from .studies.optimize import optimize  # noqa: E402  (design optimisation: the module is mjeap.studies.optimize)
 __all__.append("optimize")
+from .analysis.frf import frequency_response  # noqa: E402  (small-signal response, mjeap frf)
+__all__.append("frequency_response")
 
 import importlib as _importlib  # noqa: E402
 import importlib.abc as _abc  # noqa: E402

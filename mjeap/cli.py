@@ -340,6 +340,46 @@ def cmd_validate(args) -> int:
     return 1 if failed else 0
 
 
+#: where mjeap frf writes frf.csv, frf.json and frf.png unless told (--out)
+FRF_OUT = "out/frf"
+
+
+def _report_extra() -> bool:
+    import importlib.util
+    return importlib.util.find_spec("matplotlib") is not None
+
+
+def cmd_frf(args) -> int:
+    """Small-signal frequency response: frf.csv, frf.json (what was computed, how) and, with
+    the report extra, frf.png, all in --out; checked before any work."""
+    from .analysis import frf
+    from .io.outputs import check_outputs, replacing
+    f0, f1, n = frf.check_sweep(args.start, args.stop, args.points)
+    folder = Path(args.out or FRF_OUT)
+    if folder.exists() and not folder.is_dir():
+        raise ParameterError("--out", str(folder), "a folder for frf.csv, frf.json and frf.png", "it is a file")
+    paths = {"--out (frf.csv)": folder / "frf.csv", "--out (frf.json)": folder / "frf.json"}
+    plot = _report_extra()
+    if plot:
+        paths["--out (frf.png)"] = folder / "frf.png"
+    check_outputs(**paths)
+    scene = _scene_from_args(args)
+    r = frf.frequency_response(scene, f0, f1, n, offset=args.offset, drive=args.drive, drive_params=_params(args.param))
+    out = r.summary()
+    out["files"] = {"csv": str(paths["--out (frf.csv)"]), "json": str(paths["--out (frf.json)"]),
+                    "png": str(folder / "frf.png") if plot else "not written: the report extra (matplotlib) is not "
+                                                                 "installed (pip install 'mjeap[report]')"}
+    frf.write_frf(r, paths["--out (frf.csv)"])
+    with replacing(paths["--out (frf.json)"], "--out (frf.json)") as tmp:
+        tmp.write_text(json.dumps(out, indent=2, default=float), encoding="utf-8")
+    if plot:
+        frf.plot_frf(r, folder / "frf.png")
+    if r.admittance is None:
+        print(f"mjeap frf: admittance columns left empty: {r.admittance_reason}", file=sys.stderr)
+    print(json.dumps(out, indent=2, default=float))
+    return 0
+
+
 #: where mjeap identify writes the identified actuator file unless told (--out)
 IDENTIFIED = "out/identified.toml"
 
@@ -373,9 +413,11 @@ def _write_identified(act, out: str) -> str:
 
 def cmd_identify_step(args) -> int:
     from .analysis.identify import fit_step_response, given_rows, read_columns, step_actuator, step_rows
+    from .analysis.identify import check_identification
     act = given = None
     if args.actuator is not None:       # the file to put the fit in: checked before any work
         act = _actuator(args.actuator)
+        check_identification(act, "step")
         given = given_rows(_params(args.param), "mjeap identify step")
         step_rows(act, given)
         out_path = _identified_out(args, act)
@@ -384,8 +426,12 @@ def cmd_identify_step(args) -> int:
             if v is not None:
                 raise ParameterError(flag, v if flag == "--out" else " ".join(v),
                                      f"{flag} only with --actuator (the actuator file the identified parameters go in)")
-    d = read_columns(args.file, [args.time_column, args.curvature_column])
+    d = read_columns(args.file, [args.time_column, args.curvature_column],
+                     units={args.time_column: "s", args.curvature_column: "1/m"})
     fit = fit_step_response(d[args.time_column], d[args.curvature_column], args.voltage, args.t_step)
+    from .analysis.file_fit import check_residual
+    warning = check_residual(fit.rms_residual, float(np.ptp(d[args.curvature_column])), "identify step",
+                             "nothing written" if act is None else f"nothing written to {out_path}")
     out = {"fit": "kappa(t) = A + B exp(-p t) + C exp(-a t)", "A_per_m": fit.A, "B_per_m": fit.B, "C_per_m": fit.C,
            "transfer_function": f"K/V = {fit.gain:.4g} (s + {fit.zero:.4g}) / ((s + {fit.pole_mechanical:.4g})"
                                 f"(s + {fit.pole_electrical:.4g}))",
@@ -393,6 +439,9 @@ def cmd_identify_step(args) -> int:
            "drive": "rc-relaxation", "drive_parameters": fit.drive_parameters(),
            "use": "mjeap rollout ACTUATOR --drive rc-relaxation " +
                   " ".join(f"--param {k}={v:.6g}" for k, v in fit.drive_parameters().items())}
+    if warning:
+        out["warning"] = warning
+        print(f"mjeap: warning: {warning}", file=sys.stderr)
     if act is not None:
         out["actuator_file"] = _write_identified(step_actuator(act, fit, args.file, given), out_path)
         out["use"] = f"mjeap rollout {out_path} --voltage step:{args.voltage:g}V --duration ..."
@@ -401,33 +450,90 @@ def cmd_identify_step(args) -> int:
 
 
 def cmd_identify_hinges(args) -> int:
-    from .analysis import identify as ident
+    """The beam's stiffness scale (EI(x) kept proportional to the file's), mass scale and
+    damping ratio fitted to a tip trajectory with the file's own model
+    (:mod:`mjeap.analysis.file_fit`); the identified file is the model that was fitted."""
+    from .analysis import file_fit, identify as ident
     scene = _scene_from_args(args)
     params = _params(args.param)
     given = ident.given_rows(params, "mjeap identify hinges")
     ident.file_drive_rows(scene.actuator, args.drive, given)        # checked before the fit, as is --out
     out_path = _identified_out(args, scene.actuator)
-    d = ident.read_columns(args.file, [args.time_column, args.tip_column])
+    d = ident.read_columns(args.file, [args.time_column, args.tip_column],
+                           units={args.time_column: "s", args.tip_column: "m"})
     t, y = d[args.time_column], d[args.tip_column]
-    fit = ident.fit_hinge_parameters(scene, t, y, args.voltage, drive=args.drive, drive_params=params)
-    out = {"stiffness_N_m_per_rad": fit.stiffness, "stiffness_std": fit.stiffness_std,
-           "damping_N_m_s_per_rad": fit.damping, "damping_std": fit.damping_std,
-           "rms_residual_m": fit.rms_residual, "simulations": fit.evaluations,
-           "segments": scene.layout.segments}
-    act = ident.hinge_actuator(scene, fit, args.file, drive=args.drive, given=given)
-    err, swing = ident.reproduction_error(scene, fit, act, t, args.voltage, args.drive, params)
-    out.update(flexural_rigidity_N_m2=act.flexural_rigidity.value, damping_ratio=act.damping_ratio.value,
-               identified_file_rms_m=err)
-    if not err <= ident.REPRODUCE * swing:
-        print(json.dumps(out, indent=2))
-        raise ParameterError("identified actuator", f"{act.id} off the fitted trajectory by {err:.3g} m rms "
-                             f"({err / swing:.1%} of its swing)", f"a file that reproduces the fit within "
-                             f"{ident.REPRODUCE:.0%} of the swing", f"the file's EI and damping ratio do not give the "
-                             f"fitted hinges under the {act.drive} drive: a drive whose moment scales with EI (rc-"
-                             "relaxation's gain is a curvature per volt) cannot carry a hinge stiffness, identify it "
-                             f"with mjeap identify step; nothing written to {out_path}")
+    fit = file_fit.fit_tip_trajectory(scene, t, y, args.voltage, drive=args.drive, drive_params=params)
+    act = file_fit.trajectory_actuator(scene, fit, args.file, drive=args.drive, given=given)
+    EI = act.flexural_rigidity_at([0.0, act.length])
+    out = {**fit.as_dict(), "rms_residual_m": fit.rms_residual, "residual_fraction": fit.rms_residual / fit.swing,
+           "simulations": fit.evaluations, "segments": scene.layout.segments,
+           "flexural_rigidity_clamp_N_m2": float(EI[0]), "flexural_rigidity_tip_N_m2": float(EI[1]),
+           "mass_kg": act.total_mass(), "first_frequency_hz": file_fit_f1(scene, act)}
+    warning = file_fit.check_residual(fit.rms_residual, fit.swing, "identified actuator",
+                                      f"nothing written to {out_path}")
+    out["identified_file_rms_m"] = fit.rms_residual
+    if warning:
+        out["warning"] = warning
+        print(f"mjeap: warning: {warning}", file=sys.stderr)
     out["actuator_file"] = _write_identified(act, out_path)
-    print(json.dumps(out, indent=2))
+    print(json.dumps(out, indent=2, default=float))
+    return 0
+
+
+def file_fit_f1(scene, act) -> float:
+    """The first mode (Hz) of ``act`` built as ``scene`` is."""
+    from .analysis.identify import _scene_like
+    return float(_scene_like(scene, act).choice.first_frequency)
+
+
+def cmd_identify_piezo(args) -> int:
+    """A piezo bender's coupling, stiffness or tip mass, damping ratio, capacitance and
+    resistance fitted to stroke, tip-FRF and impedance data (or a published resonance) with
+    the file's own small-signal model (:mod:`mjeap.analysis.piezo_fit`)."""
+    from .analysis import file_fit, identify as ident, piezo_fit as pf
+    from .analysis.frf import parse_frequency
+    if not any((args.stroke, args.frf, args.impedance, args.resonance)):
+        raise ParameterError("identify piezo", "no measurement", "at least one of --stroke, --frf, --impedance "
+                             "(CSV files) or --resonance (a published first resonance, e.g. 1750Hz)")
+    resonance = None if args.resonance is None else parse_frequency(args.resonance, "--resonance")
+    scene = _scene_from_args(args)
+    ident.check_identification(scene.actuator, "piezo")
+    given = ident.given_rows(_params(args.param), "mjeap identify piezo")
+    ident.file_drive_rows(scene.actuator, None, given)
+    out_path = _identified_out(args, scene.actuator)
+    data = pf.PiezoData(
+        stroke=None if args.stroke is None else pf.read_stroke(args.stroke, args.voltage_column, args.stroke_column),
+        frf=None if args.frf is None else pf.read_frf(args.frf),
+        impedance=None if args.impedance is None else (*pf.read_impedance(args.impedance), args.impedance_state),
+        resonance=resonance,
+        sources={"stroke": args.stroke, "frf": args.frf,
+                 "impedance": f"{args.impedance} ({args.impedance_state} actuator)" if args.impedance else None,
+                 "resonance": f"{args.resonance} (given: --resonance)"})
+    fit = pf.fit_piezo(scene, data, drive_params=_params(args.param))
+    act = pf.piezo_actuator(scene, fit, data, given)
+    out = {"identified": {k: {"factor" if k != "damping_ratio" else "value": v, "std": fit.std[k]}
+                          for k, v in fit.values.items()},
+           "held": fit.held, "rms_residuals": fit.residuals, "derived": fit.derived, "evaluations": fit.evaluations}
+    name = pf.COUPLING_PARAMETER[act.drive]
+    out["file"] = {k: {"value": r[0], "source": r[2]} for k, r in act.drive_parameters.items()
+                   if k in (name, "capacitance", "resistance")}
+    out["file"].update({"damping_ratio": {"value": act.damping_ratio.value, "source": act.damping_ratio.source},
+                        "tip_block_mass_kg": {"value": act.planform.tip_block_mass,
+                                              "source": act.planform.residual_source},
+                        "flexural_rigidity_clamp_N_m2": {"value": float(act.flexural_rigidity_at(0.0)[0]),
+                                                         "source": act.layers[0].provenance("youngs_modulus")}})
+    worst = max(fit.residuals, key=fit.residuals.get)
+    warning = file_fit.check_residual(fit.residuals[worst], None, f"identify piezo ({worst})",
+                                      f"nothing written to {out_path}")
+    if warning:
+        out["warning"] = f"{worst}: {warning}"
+        print(f"mjeap: warning: {worst}: {warning}", file=sys.stderr)
+    for k, why in fit.held.items():
+        if k in ("stiffness", "tip_mass") and any(q in fit.values for q in ("stiffness", "tip_mass")):
+            print(f"mjeap identify piezo: f1 fitted by the {'tip block mass' if k == 'stiffness' else 'modulus scale'}:"
+                  f" {k} {why}", file=sys.stderr)
+    out["actuator_file"] = _write_identified(act, out_path)
+    print(json.dumps(out, indent=2, default=float))
     return 0
 
 
@@ -665,7 +771,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="comma list: peak_to_peak, returns, settling_time, max_stress_proxy, max_tip_deflection, "
                         "first_frequency, mass, free_deflection, blocked_force, energy_density (a step's), stroke (a "
                         "periodic drive's), peak_power, energy_per_cycle, max_field, max_reverse_field, max_stress, "
-                        "capacitance (piezo drives)")
+                        "capacitance (piezo drives), resonance_frequency, antiresonance_frequency, coupling_factor, "
+                        "tip_per_volt_at")
     p.add_argument("--out", default="out/sweep.csv", help="results CSV (appended; finished points are skipped)")
     from .studies.sweep import EXECUTORS
     p.add_argument("--executor", choices=EXECUTORS, default="processes")
@@ -707,6 +814,19 @@ def build_parser() -> argparse.ArgumentParser:
                         "the report extra, optimize.png (and pareto.csv, pareto.png)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_optimize)
+    p = sub.add_parser("frf", help="small-signal frequency response (tip deflection and admittance per volt) from "
+                       "the linearised model; resonance, antiresonance, effective coupling")
+    add_scene_args(p)
+    p.add_argument("--from", dest="start", required=True, help="lowest frequency, Hz or with a unit: 200Hz, 0.2kHz")
+    p.add_argument("--to", dest="stop", required=True, help="highest frequency (Hz or with a unit), up to the model's "
+                   "highest resolved mode and its step's Nyquist limit")
+    p.add_argument("--points", default=200, help="log-spaced frequencies (>= 2; default 200)")
+    p.add_argument("--offset", type=float, default=None, help="operating voltage of the drive's input (V; default the "
+                   "drive's rest voltage, V_bias/2 for piezo-bimorph)")
+    p.add_argument("--drive", help="drive name (default: the actuator's own)")
+    p.add_argument("--param", action="append", metavar="KEY=VALUE", help="drive parameter (repeatable)")
+    p.add_argument("--out", help=f"folder for frf.csv, frf.json and frf.png (default {FRF_OUT})")
+    p.set_defaults(func=cmd_frf)
     p = sub.add_parser("identify", help="fit the papers' models to measured data (CSV with a header)")
     isub = p.add_subparsers(dest="what", required=True)
     q = isub.add_parser("step", help="Dadras et al. 2021: transfer function from a curvature step response")
@@ -732,6 +852,24 @@ def build_parser() -> argparse.ArgumentParser:
     q.add_argument("--out", help=f"the identified actuator file: the actuator with EI = k L/N and the damping ratio "
                    f"of the fitted joints (default {IDENTIFIED})")
     q.set_defaults(func=cmd_identify_hinges)
+    q = isub.add_parser("piezo", help="a piezo bender's coupling (f31), stiffness or tip mass, damping ratio, "
+                        "capacitance and resistance from stroke, tip-FRF and impedance data")
+    add_scene_args(q)
+    q.add_argument("--stroke", help="CSV of stroke against voltage: columns voltage (V_sig) and stroke (tip "
+                   "deflection), units in the headers")
+    q.add_argument("--voltage-column", default="voltage")
+    q.add_argument("--stroke-column", default="stroke")
+    q.add_argument("--frf", help="CSV of the tip's frequency response per volt: frequency, tip_per_volt [, tip_phase "
+                   "(deg)], as mjeap frf writes them")
+    q.add_argument("--impedance", help="CSV of an impedance sweep: frequency and admittance [, admittance_phase], "
+                   "impedance [, impedance_phase] or capacitance [, resistance]")
+    q.add_argument("--impedance-state", choices=("free", "fixed"), default="free",
+                   help="free: the actuator could move (the motional current is in the data); fixed: blocked, as "
+                        "Jayaram et al. 2018 fixed theirs in epoxy (the data hold C and R only)")
+    q.add_argument("--resonance", help="a published first resonance (Hz or with a unit), where no sweep is at hand")
+    q.add_argument("--param", action="append", metavar="KEY=VALUE", help="drive parameter kept as given (repeatable)")
+    q.add_argument("--out", help=f"the identified actuator file (default {IDENTIFIED})")
+    q.set_defaults(func=cmd_identify_piezo)
     return ap
 
 

@@ -63,26 +63,70 @@ def check_series(time, *series, names: Sequence[str] = (), min_samples: int = MI
     return tuple(out)
 
 
-def read_columns(path: Union[str, Path], columns: Sequence[str], min_samples: int = MIN_SAMPLES) -> Dict[str, np.ndarray]:
-    """Read the named columns of a CSV with a header row. A header matches a requested name
-    when it is equal or starts with it followed by ' (' (a unit), e.g. 'time (s)' for 'time'.
-    The first column requested is the time base and is checked like :func:`check_series`."""
+def read_columns(path: Union[str, Path], columns: Sequence[str], min_samples: int = MIN_SAMPLES,
+                 units: Optional[Dict[str, str]] = None, time_base: bool = True) -> Dict[str, np.ndarray]:
+    """Read the named columns of a CSV with a header row, in SI. A header matches a
+    requested name when it is equal or is the name with a unit, ``name (unit)`` or ``name
+    [unit]`` ('time (ms)' for 'time'); its numbers are converted from that unit to the SI
+    unit ``units`` gives the column (:func:`mjeap.model.quantity.column_scale`: 'ms', 'um',
+    'mV', 'nF', ...; a header without a unit is SI; an unknown unit, or one of another
+    quantity, is refused naming the column). Without ``units`` the first column is time
+    ('s') and the others are converted from the unit they name to SI, whatever it is. With ``time_base`` the first column is the
+    time base and is checked like :func:`check_series` (else it must only increase, a
+    frequency or a voltage axis)."""
     from ..io.csvio import number, read_rows
+    from ..model.quantity import column_scale, split_header
     rows = read_rows(path, "data file")
     header = [h.strip() for h in rows[0]]
-    idx = {}
+    units = dict(units or {columns[0]: "s"})
+    idx, scale = {}, {}
     for c in columns:
-        hits = [i for i, h in enumerate(header) if h == c or h.startswith(c + " (")]
+        hits = [i for i, h in enumerate(header) if h == c or (split_header(h)[0] == c and split_header(h)[1])]
         if not hits:
             raise ParameterError("column", c, f"one of the file's columns: {', '.join(header)}")
         idx[c] = hits[0]
+        h = header[hits[0]]
+        scale[c] = column_scale(h, units.get(c), str(path))
     data = {c: np.empty(len(rows) - 1) for c in columns}
     for r, row in enumerate(rows[1:], start=2):
         for c, i in idx.items():
             data[c][r - 2] = number(row[i], f"column '{c}'", r) if i < len(row) and row[i].strip() else np.nan
-    t, *rest = check_series(data[columns[0]], *(data[c] for c in columns[1:]), names=columns[1:],
-                            min_samples=min_samples)
-    return {columns[0]: t, **dict(zip(columns[1:], rest))}
+    data = {c: v * scale[c] for c, v in data.items()}
+    if time_base:
+        t, *rest = check_series(data[columns[0]], *(data[c] for c in columns[1:]), names=columns[1:],
+                                min_samples=min_samples)
+        return {columns[0]: t, **dict(zip(columns[1:], rest))}
+    check_series(np.arange(len(rows) - 1.0), *(data[c] for c in columns), names=columns, min_samples=min_samples)
+    back = np.flatnonzero(np.diff(data[columns[0]]) <= 0)
+    if len(back):
+        raise ParameterError(f"column '{columns[0]}'", f"{data[columns[0]][back[0] + 1]:g} after "
+                             f"{data[columns[0]][back[0]]:g} (row {back[0] + 3})", "strictly increasing values")
+    return data
+
+
+#: the highest lag-one autocorrelation counted (a residual of one smooth hump)
+RHO_MAX = 0.995
+
+
+def covariance(jac: np.ndarray, residual: np.ndarray) -> Tuple[np.ndarray, float]:
+    """(covariance of the parameters, the variance inflation) of a least-squares fit with
+    Jacobian ``jac`` at residual ``residual``: s^2 (J^T J)^-1 with s^2 = |r|^2 / (n - p),
+    scaled for correlated residuals. A model that misses the data leaves a smooth residual,
+    whose lag-one autocorrelation rho leaves (1 - rho) / (1 + rho) as many independent samples
+    as there are samples (the AR(1) effective sample size), so the variance is multiplied by
+    (1 + rho) / (1 - rho); white noise leaves it as it is. inf where J^T J is singular."""
+    n, p = jac.shape
+    r = np.asarray(residual, float)
+    s2 = float(r @ r) / max(n - p, 1)
+    rho = float(np.clip((r[:-1] @ r[1:]) / (r @ r), 0.0, RHO_MAX)) if r @ r > 0 and n > 2 else 0.0
+    inflation = (1 + rho) / (1 - rho)
+    try:
+        jtj = jac.T @ jac
+        if np.linalg.cond(jtj) > 1e14:
+            raise np.linalg.LinAlgError
+        return np.linalg.inv(jtj) * s2 * inflation, inflation
+    except np.linalg.LinAlgError:
+        return np.full((p, p), np.inf), inflation
 
 
 # ---------------------------------------------------------------- Dadras et al. 2021: step response
@@ -185,7 +229,7 @@ def _step_fit(model, best, t, voltage) -> "StepFit":
 class HingeFit:
     stiffness: float             # N m / rad, every hinge
     damping: float               # N m s / rad, every hinge
-    stiffness_std: float         # 1-sigma from the Jacobian (same units)
+    stiffness_std: float         # 1-sigma, the residual's correlation counted (covariance)
     damping_std: float
     rms_residual: float          # m
     evaluations: int
@@ -227,16 +271,35 @@ def fit_hinge_parameters(scene, time, tip_deflection, voltage, drive=None, drive
     res = optimize.least_squares(residual, [np.log(k0), np.log(b0)], diff_step=1e-4, x_scale=1.0,
                                  xtol=1e-10, ftol=1e-10, max_nfev=200)
     k, b = np.exp(res.x)
-    dof = max(1, len(y) - 2)
-    s2 = 2 * res.cost / dof
-    try:
-        cov = np.linalg.inv(res.jac.T @ res.jac) * s2
-        sk, sb = np.sqrt(np.diag(cov))
-    except np.linalg.LinAlgError:
-        sk = sb = np.inf
+    cov, _ = covariance(res.jac, res.fun)           # scaled for correlated residuals (model error)
+    sk, sb = np.sqrt(np.diag(cov))
     scene.set_hinge_parameters(stiffness=k, damping=b)
     return HingeFit(float(k), float(b), float(k * sk), float(b * sb),
-                    float(np.sqrt(s2) * scale), n_eval[0])
+                    float(np.sqrt(np.mean(res.fun ** 2)) * scale), n_eval[0])
+
+
+# ---------------------------------------------------------------- which identification applies
+#: the identifications that fit a drive's own model, by drive (``identify hinges`` fits the
+#: beam of any drive: its stiffness, mass and damping)
+IDENTIFICATIONS = {"step": ("rc-relaxation", "blocking-force"), "piezo": ("piezo-bimorph", "piezo")}
+_WHAT = {"step": "Dadras et al. 2021's ionic step response (the rc-relaxation drive)",
+         "piezo": "a piezoelectric drive's coupling, capacitance, resonance and damping"}
+
+
+def check_identification(act, which: str) -> None:
+    """Refuse ``mjeap identify which`` on an actuator whose drive it does not fit, naming the
+    identification that does (before any work)."""
+    from ..drives import default_drive_name
+    drive = act.drive or default_drive_name(act)
+    if drive in IDENTIFICATIONS.get(which, (drive,)):
+        return
+    applies = [w for w, drives in IDENTIFICATIONS.items() if drive in drives] or ["hinges"]
+    raise ParameterError("mjeap identify", which, f"an actuator whose drive {which} fits: "
+                         f"{', '.join(IDENTIFICATIONS[which])} ({_WHAT[which]})",
+                         f"{act.id}{' (' + act.source_file + ')' if act.source_file else ''} is driven by {drive}: "
+                         f"use mjeap identify {' or '.join(applies)}"
+                         + ("" if "hinges" in applies else " (or identify hinges for its beam's stiffness, mass "
+                            "and damping)"))
 
 
 # ---------------------------------------------------------------- what was identified, into an actuator

@@ -303,6 +303,24 @@ class Drive:
         """None where the drive has a native MJCF form (:class:`NativeForm`); else why not."""
         return f"the {self.name} drive declares no native MJCF form"
 
+    def small_signal(self, operating_voltage: float):
+        """The drive's linear model about the input ``operating_voltage`` (V), per volt of its
+        input: moment per volt, blocked admittance, motional coupling and internal states
+        (:class:`mjeap.drives.small_signal.SmallSignal`), what ``mjeap frf`` couples to the
+        beam's linearised mechanics. A drive without one is refused there, naming it."""
+        raise ParameterError("drive", self.name, "a drive that states its small-signal model "
+                             "(Drive.small_signal, mjeap.drives.small_signal)",
+                             f"the {self.name} drive states none; sine runs measure it instead "
+                             "(mjeap.analysis.frequency.sine_sweep)")
+
+    def _operating_voltage(self, v0: float) -> float:
+        """``v0`` (V), refused outside the drive's safe range."""
+        lo, hi = self.voltage_range()
+        if not (np.isfinite(v0) and lo - 1e-12 <= v0 <= hi + 1e-12):
+            raise ParameterError("offset", v0, f"an operating voltage in the safe range [{lo:g}, {hi:g}] V of "
+                                 f"{self.scene.actuator.id} under {self.name}")
+        return float(v0)
+
     def describe(self) -> str:
         return f"{self.name} ({self.model_used})" if self.model_used else self.name
 

@@ -104,6 +104,22 @@ class BlockingForceDrive(OpenLoop, NativeForm, Drive):
         return {"blocking_force (N)": float(self.force.x[0, 0]), "drive_moment (N m)": float(self._moment),
                 "stiffness_factor (-)": float(self.part.stiffness_scale)}
 
+    def small_signal(self, operating_voltage: float):
+        """Linear (without a stiffness table): the blocking force's state F_B' = (F_1 V -
+        F_B) / tau, the moment (2/3) L F_B on every hinge. Its model draws no current."""
+        from .small_signal import SmallSignal
+        v0 = self._operating_voltage(operating_voltage)
+        if self.stiffness.v.size:
+            raise ParameterError("drive_params", "stiffness_table", "a blocking-force drive without a stiffness table "
+                                 "for a small-signal model", "the table makes the beam's stiffness a function of the "
+                                 "voltage; run sine sweeps instead (mjeap.analysis.frequency.sine_sweep)")
+        tau, F1, n = float(self.params["time_constant"]), float(self.params["blocking_force_per_volt"]), \
+            self.scene.layout.segments
+        return SmallSignal(v0, "V", np.zeros(n), state_matrix=[[-1.0 / tau]], state_input=[F1 / tau],
+                           moment_from_state=np.full((n, 1), 2.0 / 3.0 * self.L), current=False,
+                           no_current="the blocking-force drive (Mutlu 2013) models no current: its moment follows "
+                                      "a first-order force, with no charge or motional coupling in the model")
+
     def reference_curvature(self, t, v, initial_curvature=0.0):
         """Quasi-static: uniform curvature (2/3) F_B L / (f(V) EI), F_B the same first-order
         response (:func:`mjeap.model.lti.lsim`; beam inertia and damping neglected)."""

@@ -156,6 +156,22 @@ class ElectrostrictiveDrive(OpenLoop, Drive):
         return {"field (V/m)": float(self._E), "drive_moment (N m)": float(self._M),
                 "stiffness_factor (-)": float(self.part.stiffness_scale)}
 
+    def small_signal(self, operating_voltage: float):
+        """Quadratic in V, so linear about V0 with dM/dV = 2 M(1 V) V0 on every hinge (zero
+        about 0 V). Its model draws no current. Field stiffening is refused (the beam's
+        stiffness would follow the voltage)."""
+        from .small_signal import SmallSignal
+        v0 = self._operating_voltage(operating_voltage)
+        if self.factors is not None:
+            raise ParameterError("drive_params", "stiffening", "False for a small-signal model",
+                                 "field stiffening makes the beam's stiffness a function of the voltage; run sine "
+                                 "sweeps instead (mjeap.analysis.frequency.sine_sweep)")
+        n = self.scene.layout.segments
+        return SmallSignal(v0, "V", np.full(n, 2.0 * self._M_per_V2 * v0), current=False,
+                           no_current="the electrostrictive drive (Metello 2020) models no current: its moment is "
+                                      "the field's alone, with no charge or motional coupling in the model",
+                           notes=f"dM/dV = 2 M(1 V) V0 = {2.0 * self._M_per_V2 * v0:.4g} N m/V at V0 = {v0:g} V")
+
     def reference_curvature(self, t, v, initial_curvature=0.0):
         """Quasi-static uniform curvature M(V) / (f(E) EI) of the continuum beam."""
         EI = float(self.scene.actuator.flexural_rigidity_at(0.0)[0])

@@ -33,5 +33,12 @@ class PassiveDrive(OpenLoop, Drive):
     def _moment_history(self, v):
         return np.zeros((len(v), self.scene.layout.segments))
 
+    def small_signal(self, operating_voltage: float):
+        """No input: a zero moment per volt and no current."""
+        from .small_signal import SmallSignal
+        n = self.scene.layout.segments
+        return SmallSignal(float(operating_voltage), "V", np.zeros(n), current=False,
+                           no_current="drive 'none' has no input and draws no current")
+
     def native_reason(self):
         return "no drive to compile: the threaded engine runs the free beam"

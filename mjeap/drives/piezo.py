@@ -89,6 +89,9 @@ class LinearPiezo(OpenLoop, NativeForm, Drive):
     and motional (sum_j Gamma_j times the hinges' central rate). A subclass calls
     :meth:`_couple` from its ``__init__`` and gives :meth:`resistive_current`."""
 
+    #: the voltage the drive's input is (its small-signal response is per volt of it)
+    VOLTAGE_NAME = "V"
+
     def _couple(self, gamma, v0: float, m0=None, capacitance: float = 0.0) -> None:
         """Gamma_j (N m/V per hinge), the rest voltage V_0 (V), per-hinge offsets M0_j (N m;
         None: M_j = Gamma_j (V - V_0)) and the dielectric capacitance (F)."""
@@ -195,6 +198,19 @@ class LinearPiezo(OpenLoop, NativeForm, Drive):
                 "current_capacitive (A)": i_c, "current_motional (A)": i_m,
                 "drive_moment_root (N m)": float(self._m[0])}
 
+    def small_signal(self, operating_voltage: float):
+        """Linear in the drive's voltage at any operating point: moment per volt Gamma_j per
+        hinge, the resistive current's conductance per volt (its slope, the leakage being
+        affine in the voltage), the dielectric capacitance and the motional coupling Gamma_j
+        (the same coefficient by reciprocity, module text)."""
+        from .small_signal import SmallSignal
+        v0 = self._operating_voltage(operating_voltage)
+        g = np.array(self.gamma, dtype=float)
+        return SmallSignal(v0, self.VOLTAGE_NAME, g, conductance=self.resistive_current(v0 + 1.0) -
+                           self.resistive_current(v0), capacitance=self._capacitance, coupling=g,
+                           notes="Gamma_j N m/V per hinge; I = G V + C dV/dt + sum_j Gamma_j dtheta_j/dt per volt "
+                                 f"of {self.VOLTAGE_NAME}")
+
     # -- the laminate: fields, stresses and capacitances (mjeap.model.laminate) -------------
     def laminate(self):
         """The actuator's layer stack wired as this drive wires it
@@ -219,6 +235,7 @@ class LinearPiezo(OpenLoop, NativeForm, Drive):
 @register_drive
 class PiezoBimorphDrive(LinearPiezo):
     name = "piezo-bimorph"
+    VOLTAGE_NAME = "V_sig"
     actuators = ("pzt-hamr-large", "pzt-hamr-small", "pzt-robobee")
     model_used = "unipolar simultaneous drive, Wood/Jafferis effective stress"
     #: a core with a piezo layer of equal thickness either side (:meth:`stack_reason`);

@@ -230,6 +230,24 @@ class RCRelaxationDrive(NativeForm, Drive):
     def closed_loop_reason(self):
         return "the back-relaxation acts on every moment the beam carries, so the moments follow the hinge angles"
 
+    def small_signal(self, operating_voltage: float):
+        """Linear at any operating point. States (r_1 .. r_N, v_c): r_j' = -z r_j + (z - p)
+        theta_j, v_c' = p_elec (V - v_c); moments k_j r_j + Gamma v_c; current C p_elec (V -
+        v_c), the double layer's charging (no motional current: the model has none)."""
+        from .small_signal import SmallSignal
+        v0 = self._operating_voltage(operating_voltage)
+        p, n = self.params, self.scene.layout.segments
+        z, pm, pe, C = p["zero"], p["pole_mechanical"], p["pole_electrical"], p["capacitance"]
+        A = np.diag(np.r_[np.full(n, -z), -pe])
+        B = np.r_[np.zeros(n), pe]
+        F = np.vstack([(z - pm) * np.eye(n), np.zeros((1, n))])
+        G = np.hstack([np.diag(self.part.hinge_stiffness()), np.full((n, 1), self.gamma)])
+        h = np.r_[np.zeros(n), -C * pe]
+        return SmallSignal(v0, "V", np.zeros(n), conductance=C * pe, state_matrix=A, state_input=B,
+                           state_from_angles=F, moment_from_state=G, current_from_state=h,
+                           notes="eq. (8) as the drive runs it: RC charging, Gamma v_c on every hinge, the "
+                                 "standard-linear-solid back-relaxation k r inside the beam")
+
     def transfer_function(self) -> signal.TransferFunction:
         """Eq. (8): K(s)/V(s) in 1/(m V)."""
         p = self.params

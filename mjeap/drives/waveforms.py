@@ -87,18 +87,23 @@ class Waveform:
 
 
 def _csv_samples(path: str) -> tuple:
+    """(time s, voltage V) of a ``csv:`` waveform: the columns named time (or t, t_s) and
+    voltage (or v, v_v), each in the unit its header gives, ``time (ms)``, ``voltage (mV)``
+    (:func:`mjeap.model.quantity.column_scale`; none: SI; an unknown one refused)."""
     from ..io.csvio import read_rows
+    from ..model.quantity import column_scale, split_header
     rows = read_rows(path, "csv")
     if len(rows) < 3:
         raise ParameterError("csv", path, "a CSV file with a header and at least 2 rows")
-    header = [h.strip().lower() for h in rows[0]]
+    names = [split_header(h)[0].strip().lower() for h in rows[0]]
     try:
-        it = next(i for i, h in enumerate(header) if h.startswith("time") or h in ("t", "t_s"))
-        iv = next(i for i, h in enumerate(header) if h.startswith("voltage") or h in ("v", "v_v"))
+        it = next(i for i, h in enumerate(names) if h.startswith("time") or h in ("t", "t_s"))
+        iv = next(i for i, h in enumerate(names) if h.startswith("voltage") or h in ("v", "v_v"))
     except StopIteration:
         raise ParameterError("csv", path, f"columns 'time' and 'voltage' (found {rows[0]})") from None
+    scale = np.array([column_scale(rows[0][it].strip(), "s", path), column_scale(rows[0][iv].strip(), "V", path)])
     try:
-        data = np.array([[float(r[it]), float(r[iv])] for r in rows[1:] if r], dtype=float)
+        data = np.array([[float(r[it]), float(r[iv])] for r in rows[1:] if r], dtype=float) * scale
     except (ValueError, IndexError) as e:
         raise ParameterError("csv", path, f"numbers in every row ({e})") from None
     if len(data) < 2:

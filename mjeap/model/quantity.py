@@ -3,21 +3,22 @@
 
 A unit is a product of prefixed units with integer powers, ``/`` dividing by the next
 factor (or a parenthesised group): ``kg/m^3``, ``m^2/V^2``, ``N m / rad``. Known units: m, g,
-s, A, Hz, N, Pa, J, W, C, V, F, ohm (or Ω), rad, and ``-`` for none; prefixes G, M, k, c,
-m, u (µ), n, p. A quantity is checked against the unit expected (its dimension must match)
-and returned in SI.
+s, A, Hz, N, Pa, J, W, C, V, F, S (siemens), ohm (or Ω), rad, deg (or °), and ``-`` for
+none; prefixes G, M, k, c, m, u (µ), n, p. A quantity is checked against the unit expected
+(its dimension must match) and returned in SI. A CSV column's header ``name (unit)`` (or
+``name [unit]``) is read the same way (:func:`column_scale`).
 """
 from __future__ import annotations
 
 import math
 import re
-from typing import Tuple
+from typing import Optional, Tuple
 
 import numpy as np
 
 from ..errors import ParameterError
 
-__all__ = ["parse_unit", "to_si", "same_dimension"]
+__all__ = ["parse_unit", "to_si", "same_dimension", "split_header", "column_scale"]
 
 # (factor to SI, dimension exponents of m, kg, s, A)
 _BASE = {
@@ -25,11 +26,12 @@ _BASE = {
     "Hz": (1.0, (0, 0, -1, 0)), "N": (1.0, (1, 1, -2, 0)), "Pa": (1.0, (-1, 1, -2, 0)),
     "J": (1.0, (2, 1, -2, 0)), "W": (1.0, (2, 1, -3, 0)), "C": (1.0, (0, 0, 1, 1)),
     "V": (1.0, (2, 1, -3, -1)), "F": (1.0, (-2, -1, 4, 2)), "ohm": (1.0, (2, 1, -3, -2)),
-    "Ω": (1.0, (2, 1, -3, -2)), "rad": (1.0, (0, 0, 0, 0)),
+    "Ω": (1.0, (2, 1, -3, -2)), "S": (1.0, (-2, -1, 3, 2)), "rad": (1.0, (0, 0, 0, 0)),
+    "deg": (math.pi / 180.0, (0, 0, 0, 0)), "°": (math.pi / 180.0, (0, 0, 0, 0)),
 }
 _PREFIX = {"G": 1e9, "M": 1e6, "k": 1e3, "c": 1e-2, "m": 1e-3, "u": 1e-6, "µ": 1e-6, "n": 1e-9, "p": 1e-12}
 _NONE = (1.0, (0, 0, 0, 0))
-_TOKEN = re.compile(r"\s*(\(|\)|/|\*|\^-?\d+|[A-Za-zµΩ]+|1|\s)")
+_TOKEN = re.compile(r"\s*(\(|\)|/|\*|\^-?\d+|[A-Za-zµΩ°]+|1|\s)")
 _NUMBER = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?inf|nan)\s*(.*?)\s*$", re.IGNORECASE)
 
 
@@ -123,3 +125,35 @@ def to_si(value, unit: str, where: str) -> float:
     if not math.isfinite(v):
         raise ParameterError(where, value, f"a finite quantity in {unit}")
     return v
+
+
+_HEADER = re.compile(r"^\s*(.*?)\s*(?:\(([^()]*)\)|\[([^\[\]]*)\])\s*$")
+
+
+def split_header(header: str) -> Tuple[str, str]:
+    """(name, unit) of a CSV header ``name (unit)`` or ``name [unit]``; the unit '' where
+    there is none ('time' -> ('time', ''))."""
+    m = _HEADER.match(header)
+    if m is None:
+        return header.strip(), ""
+    return m.group(1), (m.group(2) if m.group(2) is not None else m.group(3)).strip()
+
+
+def column_scale(header: str, unit: Optional[str], where: str) -> float:
+    """The factor that turns column ``header``'s numbers into SI ``unit`` (its dimension):
+    1 for a header without a unit (read as SI), else the unit's factor, e.g. 1e-3 for
+    'time (ms)' read as 's'. An unknown unit, or one of another dimension, is refused with a
+    ParameterError naming the column (``where``: the file); ``unit`` None: any dimension."""
+    name, text = split_header(header)
+    if not text or text in ("-", "SI"):
+        return 1.0
+    try:
+        f, d = parse_unit(text)
+    except ValueError:
+        raise ParameterError(f"column '{header}' of {where}", text, f"a unit{' of ' + unit if unit else ''} mjeap "
+                             f"reads (units: {', '.join(_BASE)}; prefixes {', '.join(_PREFIX)})",
+                             "an unknown unit; nothing was read") from None
+    if unit is not None and d != parse_unit(unit)[1]:
+        raise ParameterError(f"column '{header}' of {where}", text, f"a unit of {unit} (the column's quantity)",
+                             f"'{text}' measures another quantity")
+    return f

@@ -119,7 +119,8 @@ def identify(quick: bool = False) -> Experiment:
         f"Truth: k = 1.3 x the catalog hinge ({truth[0]:.4g} N m/rad), b = {truth[1]:.4g} N m s/rad "
         "(damping ratio near 0.5, so the mechanical transient is visible); a 1 V step with a fast "
         "(10 ms) blocking-force rise, sampled at 1 kHz for 0.3 s with Gaussian noise of 1 % of the swing. "
-        f"Start from the catalog values; {fit.evaluations} simulations; 1-sigma from the Jacobian: "
+        f"Start from the catalog values; {fit.evaluations} simulations; 1-sigma from the Jacobian (the "
+        "residual's correlation counted, mjeap.analysis.identify.covariance): "
         f"k +- {fit.stiffness_std / fit.stiffness * 100:.2f} %, b +- {fit.damping_std / fit.damping * 100:.2f} %.",
         "With the catalog's slow (2 s) blocking force the damping is not identifiable (b/k << 2 s): the "
         "trajectory is quasi-static. Measured data must excite the mechanical transient to fit b.",

@@ -68,6 +68,8 @@ PERIODIC_READS = {
     "the whole run": {"max_stress_proxy", "max_tip_deflection", "max_stress"},
     "no run (the scene, the waveform's extremes)": {"first_frequency", "mass", "max_field", "max_reverse_field",
                                                      "capacitance"},
+    "no run (the linearised model's frequency response)": {"resonance_frequency", "antiresonance_frequency",
+                                                           "coupling_factor", "tip_per_volt_at"},
     "refused (a step's)": set(M.STEP_ONLY_METRICS),
     "bookkeeping text": {"estimated_error", "stopped_early"},
 }

@@ -1,7 +1,8 @@
 """The metrics of a sweep: each reduces a point's rollout (or its scene alone) to a number,
 a bool or a str. :data:`METRICS` holds them by name (:func:`register_metric` adds one); the
 sets beside it say which need no rollout (:data:`STATIC_METRICS`: ``first_frequency``,
-``mass``), which read only the run's end or every step of its last period (how a point's
+``mass`` and the small-signal ``resonance_frequency``, ``antiresonance_frequency``,
+``coupling_factor``, ``tip_per_volt_at``), which read only the run's end or every step of its last period (how a point's
 rollout is sampled) and which need the run's own scene; :func:`check_metric_settings`
 refuses, before any point runs, a metric its points cannot give.
 
@@ -21,6 +22,8 @@ run) and ``capacitance`` (F, the free capacitance the signal terminal sees).
 """
 from __future__ import annotations
 
+import json
+import weakref
 from typing import Callable, Dict, Optional, Sequence
 
 import numpy as np
@@ -343,6 +346,66 @@ def metric_energy_per_cycle(r, point, scene) -> float:
     return float(mean * period)
 
 
+# ---------------------------------------------------------------- small-signal metrics
+#: the admittance's resonance is searched between these multiples of the first mode
+RESONANCE_SEARCH = (0.25, 4.0)
+_SMALL_SIGNAL = weakref.WeakKeyDictionary()
+
+
+def _small_signal(point, scene):
+    """The point's small-signal model (:class:`mjeap.analysis.frf.SmallSignalModel`) about its
+    ``offset`` (V) with its ``drive.*`` parameters, and its resonances, kept per scene."""
+    from ...analysis.frf import SmallSignalModel
+    params = {k[6:]: v for k, v in point.items() if k.startswith("drive.")}
+    key = (float(point.get("offset") or 0.0), json.dumps(params, sort_keys=True, default=str), scene.part.revision)
+    cache = _SMALL_SIGNAL.setdefault(scene, {})
+    if key not in cache:
+        model = SmallSignalModel(scene, drive_params=params, operating_voltage=key[0])
+        f1 = scene.choice.first_frequency
+        lo, hi = RESONANCE_SEARCH
+        cache.clear()
+        cache[key] = (model, model.resonances(lo * f1, min(hi * f1, scene.choice.highest_frequency)))
+    return cache[key]
+
+
+def _resonance(point, scene, which: int, name: str) -> float:
+    _, found = _small_signal(point, scene)
+    if found[which] is None:
+        raise ParameterError("metrics", name, "a drive whose admittance shows the first mode's resonance",
+                             found[2])
+    return float(found[which])
+
+
+def metric_resonance_frequency(r, point, scene) -> float:
+    """Resonance (Hz): the admittance's first maximum between RESONANCE_SEARCH x the first
+    mode, from the small-signal model about the point's offset (:mod:`mjeap.analysis.frf`);
+    no rollout. Refused for a drive whose model draws no current."""
+    return _resonance(point, scene, 0, "resonance_frequency")
+
+
+def metric_antiresonance_frequency(r, point, scene) -> float:
+    """Antiresonance (Hz): the admittance's first minimum after the resonance; no rollout."""
+    return _resonance(point, scene, 1, "antiresonance_frequency")
+
+
+def metric_coupling_factor(r, point, scene) -> float:
+    """Effective electromechanical coupling k_eff = sqrt(1 - (f_r / f_a)^2) (-) of the first
+    mode, from the admittance's resonance and antiresonance; no rollout."""
+    fr = _resonance(point, scene, 0, "coupling_factor")
+    fa = _resonance(point, scene, 1, "coupling_factor")
+    return float(np.sqrt(max(0.0, 1.0 - (fr / fa) ** 2)))
+
+
+def metric_tip_per_volt_at(r, point, scene) -> float:
+    """Tip deflection per volt (m/V) of the small-signal response at the point's
+    ``frequency`` (Hz), about its ``offset`` (V), per volt of the drive's input; no rollout."""
+    f = float(point.get("frequency") or 0.0)
+    if not f > 0:
+        raise ParameterError("frequency", point.get("frequency"), "a frequency > 0 Hz for tip_per_volt_at")
+    model, _ = _small_signal(point, scene)
+    return float(abs(model.tip([f])[0]))
+
+
 METRICS: Dict[str, Callable] = {
     "estimated_error": metric_estimated_error, "stopped_early": metric_stopped_early,
     "peak_to_peak": metric_peak_to_peak, "returns": metric_returns, "settling_time": metric_settling_time,
@@ -352,9 +415,12 @@ METRICS: Dict[str, Callable] = {
     "peak_power": metric_peak_power, "energy_per_cycle": metric_energy_per_cycle, "stroke": metric_stroke,
     "max_field": metric_max_field, "max_reverse_field": metric_max_reverse_field, "max_stress": metric_max_stress,
     "capacitance": metric_capacitance,
+    "resonance_frequency": metric_resonance_frequency, "antiresonance_frequency": metric_antiresonance_frequency,
+    "coupling_factor": metric_coupling_factor, "tip_per_volt_at": metric_tip_per_volt_at,
 }
 #: metrics that need no rollout: the point's scene alone (``fn(None, point, scene)``)
-STATIC_METRICS = {"first_frequency", "mass", "max_field", "max_reverse_field", "capacitance"}
+STATIC_METRICS = {"first_frequency", "mass", "max_field", "max_reverse_field", "capacitance", "resonance_frequency",
+                  "antiresonance_frequency", "coupling_factor", "tip_per_volt_at"}
 #: metrics that read only the run's end: their points sample sparsely (the scene holds the end)
 END_METRICS = {"free_deflection", "blocked_force", "energy_density"}
 #: metrics that read every step of the last period: their points sample every step
@@ -367,7 +433,9 @@ OWN_SCENE_METRICS = {"blocked_force", "energy_density"}
 METRIC_UNITS = {"peak_to_peak": "1/m", "settling_time": "s", "max_stress_proxy": "Pa", "max_tip_deflection": "m",
                 "first_frequency": "Hz", "mass": "kg", "free_deflection": "m", "blocked_force": "N",
                 "energy_density": "J/kg", "peak_power": "W", "energy_per_cycle": "J", "stroke": "m",
-                "max_field": "V/m", "max_reverse_field": "V/m", "max_stress": "Pa", "capacitance": "F"}
+                "max_field": "V/m", "max_reverse_field": "V/m", "max_stress": "Pa", "capacitance": "F",
+                "resonance_frequency": "Hz", "antiresonance_frequency": "Hz", "coupling_factor": "-",
+                "tip_per_volt_at": "m/V"}
 #: the waveforms of a periodic drive (the others: a step)
 PERIODIC_WAVEFORMS = ("square", "sine", "triangle")
 #: metrics with a step's meaning, refused under a periodic drive: what to read instead
