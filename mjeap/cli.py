@@ -215,12 +215,17 @@ def _scene_from_args(args, units=None):
 
 def cmd_mjcf(args) -> int:
     """The driven model file (mm, mg, s; actuator 'drive' in V where the drive compiles in)."""
+    from .io.outputs import check_outputs
     from .simulation.model_file import model_file
+    from .simulation.scene import input_files
     from .units import REAL_TIME_UNITS
+    to_file = args.output not in (None, "-")
+    if to_file:                                    # before any work: never a link, never the actuator file
+        check_outputs(inputs=input_files([args.name]), **{"--output": args.output})
     scene = _scene_from_args(args, REAL_TIME_UNITS)
     f = model_file(scene)
     xml = f"<!-- {scene.actuator.id}: {f.note} Units: {scene.units.describe()}. -->\n" + f.spec.to_xml()
-    if args.output in (None, "-"):
+    if not to_file:
         sys.stdout.write(xml)
     else:
         from .io.outputs import replacing
@@ -256,6 +261,10 @@ def cmd_rollout(args) -> int:
             if given is not None:
                 raise ParameterError(flag, given, f"no {flag} with --accuracy (the target chooses the model and "
                                      "estimates its error)")
+    from .io.outputs import check_outputs
+    from .simulation.scene import input_files
+    # before any work (the scene's build too): never a link, never the actuator file or the waveform's CSV
+    check_outputs(inputs=input_files([args.name], [args.voltage]), rrd=args.rrd, csv_path=args.csv)
     scene = _scene_from_args(args)
     params = _params(args.param)
     r = rollout(scene, args.voltage, args.duration, drive=args.drive, drive_params=params,
@@ -307,16 +316,16 @@ def cmd_validate(args) -> int:
 IDENTIFIED = "out/identified.toml"
 
 
-def _identified_out(args, act) -> str:
-    """The identified file's path (--out, default IDENTIFIED), checked before any work: a
-    writable path other than the actuator file it comes from (a hand-written file's comments
-    and units would be lost)."""
-    from .io.outputs import check_outputs
+def _identified_out(args, act, stack) -> str:
+    """The identified file's path (--out, default IDENTIFIED: a name mjeap picks), checked and
+    locked for the run before any work (``stack``: an ExitStack holding the lock): a
+    writable path other than the run's inputs, the actuator file it comes from (a
+    hand-written file's comments and units would be lost) and the data file (the
+    measurements). A second identify on the same --out is refused at once."""
+    from .io.outputs import run_guard
     out = args.out or IDENTIFIED
-    if act.source_file and Path(out).resolve() == Path(act.source_file).resolve():
-        raise ParameterError("--out", out, f"a path other than the actuator file {act.source_file}",
-                             "it would replace the hand-written file, and its comments and units with it")
-    check_outputs(**{"--out": out})
+    inputs = [("actuator file", act.source_file if act is not None else None), ("data file", args.file)]
+    stack.enter_context(run_guard(inputs=inputs, picked=() if args.out else ("--out",), **{"--out": out}))
     return out
 
 
@@ -329,19 +338,25 @@ def _write_identified(act, out: str) -> str:
     from .simulation.scene import Scene
     make_drive(None, Scene(act, segments=2, gravity=False))
     text = actuator_toml(act)
-    with replacing(out, "--out") as tmp:
+    with replacing(out, "--out", picked=out == IDENTIFIED) as tmp:
         tmp.write_text(text, encoding="utf-8")
     return out
 
 
 def cmd_identify_step(args) -> int:
+    from contextlib import ExitStack
+    with ExitStack() as stack:
+        return _identify_step(args, stack)
+
+
+def _identify_step(args, stack) -> int:
     from .analysis.identify import fit_step_response, given_rows, read_columns, step_actuator, step_rows
     act = given = None
     if args.actuator is not None:       # the file to put the fit in: checked before any work
         act = _actuator(args.actuator)
         given = given_rows(_params(args.param), "mjeap identify step")
         step_rows(act, given)
-        out_path = _identified_out(args, act)
+        out_path = _identified_out(args, act, stack)
     else:
         for flag, v in (("--out", args.out), ("--param", args.param)):
             if v is not None:
@@ -364,12 +379,18 @@ def cmd_identify_step(args) -> int:
 
 
 def cmd_identify_hinges(args) -> int:
+    from contextlib import ExitStack
+    with ExitStack() as stack:
+        return _identify_hinges(args, stack)
+
+
+def _identify_hinges(args, stack) -> int:
     from .analysis import identify as ident
     scene = _scene_from_args(args)
     params = _params(args.param)
     given = ident.given_rows(params, "mjeap identify hinges")
     ident.file_drive_rows(scene.actuator, args.drive, given)        # checked before the fit, as is --out
-    out_path = _identified_out(args, scene.actuator)
+    out_path = _identified_out(args, scene.actuator, stack)
     d = ident.read_columns(args.file, [args.time_column, args.tip_column])
     t, y = d[args.time_column], d[args.tip_column]
     fit = ident.fit_hinge_parameters(scene, t, y, args.voltage, drive=args.drive, drive_params=params)
