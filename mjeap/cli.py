@@ -10,7 +10,7 @@ from typing import List, Optional
 
 import numpy as np
 
-from .errors import ParameterError
+from .errors import ParameterError, printable
 from .io.commandline import arg_number, run_command
 
 
@@ -28,16 +28,18 @@ def cmd_list(args) -> int:
 
 def _actuator(name):
     """The actuator a command names (catalog id or file), read before any work; a layer value
-    outside its material's range (RangeWarning) is told as one line, ``mjeap: warning: ...``."""
+    outside its material's range (RangeWarning) or a size outside a plausible one
+    (GeometryWarning) is told as one line, ``mjeap: warning: ...``."""
     import warnings
+    from .model.actuator import GeometryWarning
     from .model.catalog import get_actuator
     from .model.materials import RangeWarning
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         act = get_actuator(name)
     for w in caught:
-        if issubclass(w.category, RangeWarning):
-            print(f"mjeap: warning: {w.message}", file=sys.stderr)
+        if issubclass(w.category, (RangeWarning, GeometryWarning)):
+            print(f"mjeap: warning: {printable(w.message)}", file=sys.stderr)
         else:
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     return act
@@ -80,7 +82,8 @@ def describe(name: str) -> dict:
         layers.append({
             "name": l.name, "material": l.material,
             "thickness": (l.thickness, "m", l.provenance("thickness")),
-            "width": (l.width if l.width is not None else "planform", "m", l.provenance("width")),
+            "width": (l.width if l.width is not None else "planform", "m",
+                      l.provenance("width") if l.width is not None else "the planform's width"),
             "youngs_modulus": (l.youngs_modulus, "Pa", l.provenance("youngs_modulus")),
             "poisson_ratio": (l.poisson_ratio, "-", l.provenance("poisson_ratio")),
             "density": (l.density, "kg/m^3", l.provenance("density")),
@@ -121,11 +124,23 @@ def describe(name: str) -> dict:
     }
 
 
+def _printable_tree(x):
+    """``x`` (dicts, lists, tuples of values) with every string :func:`~mjeap.errors.printable`."""
+    if isinstance(x, str):
+        return printable(x)
+    if isinstance(x, dict):
+        return {printable(k): _printable_tree(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return type(x)(_printable_tree(v) for v in x)
+    return x
+
+
 def cmd_show(args) -> int:
     d = describe(args.name)
-    if args.json:
+    if args.json:                      # JSON escapes control characters itself (and all non-ASCII)
         print(json.dumps(d, indent=2, default=str))
         return 0
+    d = _printable_tree(d)             # every string from the user's file, safe on a terminal
     print(f"{d['id']}: {d['title']}\n  source: {d['document']}\n  file: {d['file']}\n\nlayers (bottom to top):")
     for l in d["layers"]:
         print(f"  {l['name']} ({l['material']})")

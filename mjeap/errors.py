@@ -7,6 +7,19 @@ import sys
 from typing import Iterable, Optional
 
 
+def printable(text) -> str:
+    """``text`` safe to print on a terminal: its control and format characters (escape
+    sequences, carriage returns, bidirectional overrides; a title in a user's file can hold
+    any) written as Python escapes (``\\x1b``, ``\\n``, ``\\u202e``), everything else as it is."""
+    import unicodedata
+    text = str(text)
+    if text.isprintable():
+        return text
+    return "".join(c if c.isprintable() or c == " " else
+                   (repr(c)[1:-1] if unicodedata.category(c) in ("Cc", "Cf", "Zl", "Zp", "Cs", "Co", "Cn")
+                    else c) for c in text)
+
+
 class MjeapError(Exception):
     """Base class of mjeap's own errors."""
 
