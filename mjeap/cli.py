@@ -346,15 +346,18 @@ def _identified_out(args, act, stack) -> str:
 
 def _write_identified(act, out: str) -> str:
     """Write ``act`` to ``out`` whole or not at all (mjeap.io.outputs.replacing), once its
-    drive was built on it (an identified value the drive refuses is never written)."""
+    drive was built on it (an identified value the drive refuses is never written) and its
+    text read back as an actuator file (what cannot be read back is never put in place)."""
     from .drives import make_drive
     from .io.outputs import replacing
     from .model.actuator_file import actuator_toml
     from .simulation.scene import Scene
+    from .model.actuator_file import read_actuator
     make_drive(None, Scene(act, segments=2, gravity=False))
     text = actuator_toml(act)
     with replacing(out, "--out", picked=out == IDENTIFIED) as tmp:
         tmp.write_text(text, encoding="utf-8")
+        read_actuator(tmp.with_name(tmp.name))   # what is written reads back, or it is not put in place
     return out
 
 
@@ -490,10 +493,35 @@ def _sweep_values(spec: str, random: bool, actuator=None):
     return name, [to_value(name, v.strip(), actuator) for v in rhs.split(",")]
 
 
+def _once(flag: str, specs, form: str = "NAME=VALUE") -> dict:
+    """``NAME=VALUE`` options (``--set``, ``--vary``) as name -> value text, before any work:
+    each NAME once (a repeated one would silently keep the last), none empty."""
+    out = {}
+    for spec in specs or []:
+        name, sep, rhs = spec.partition("=")
+        name = name.strip()
+        if not sep or not name:
+            raise ParameterError(flag, spec, form)
+        if name in out:
+            raise ParameterError(flag, spec, f"each NAME once ({name} is given twice: {flag} {name}={out[name]} "
+                                 f"and {flag} {spec})")
+        out[name] = rhs.strip()
+    return out
+
+
+def _distinct(vary: dict, fixed: dict) -> None:
+    """A name varied (--vary) is not also fixed (--set)."""
+    both = [n for n in vary if n in fixed]
+    if both:
+        raise ParameterError("--set", f"{both[0]}={fixed[both[0]]}", f"a setting that is not also varied "
+                             f"(--vary {both[0]}=...)")
+
+
 def cmd_sweep(args) -> int:
     from . import sweep
     from .design import to_value
-    raw = dict(kv.partition("=")[::2] for kv in (args.set or []))
+    raw = _once("--set", args.set)
+    _distinct(_once("--vary", args.vary, "NAME=a,b,c or NAME=lo:hi:n (grid) or NAME=lo..hi (with --random)"), raw)
     actuator = raw.get("actuator", sweep.PARAMETERS["actuator"])
     values = dict(_sweep_values(v, args.random is not None, actuator) for v in (args.vary or []))
     if not values:
@@ -533,13 +561,13 @@ def cmd_sweep(args) -> int:
 def cmd_optimize(args) -> int:
     from .optimize import optimize
     from .design import to_value
-    vary = {}
-    for spec in args.vary or []:
-        name, sep, rhs = spec.partition("=")
-        if not sep or not name.strip() or not rhs.strip():
-            raise ParameterError("--vary", spec, "NAME=LOW:HIGH, e.g. actuator.length=5mm:15mm")
-        vary[name.strip()] = rhs.strip()
-    base = {k: to_value(k, v, args.name) for k, v in (kv.partition("=")[::2] for kv in (args.set or []))}
+    vary = _once("--vary", args.vary, "NAME=LOW:HIGH, e.g. actuator.length=5mm:15mm")
+    for name, rhs in vary.items():
+        if not rhs:
+            raise ParameterError("--vary", f"{name}=", "NAME=LOW:HIGH, e.g. actuator.length=5mm:15mm")
+    raw = _once("--set", args.set)
+    _distinct(vary, raw)
+    base = {k: to_value(k, v, args.name) for k, v in raw.items()}
     r = optimize(args.name, vary, maximize=args.maximize, minimize=args.minimize, subject_to=args.subject_to or (),
                  voltage=args.voltage, duration=args.duration, base=base,
                  metrics=[m for m in (args.metrics or "").split(",") if m], method=args.method, starts=args.starts,
