@@ -609,6 +609,45 @@ def cmd_view(args) -> int:
     return 0
 
 
+def examples_dir() -> Path:
+    """The examples as installed with the wheel (the package ``mjeap.examples_files``, mapped
+    to the repository's ``examples`` by pyproject.toml), else the repository's folder."""
+    here = Path(__file__).resolve().parent
+    installed = here / "examples_files"
+    return installed if installed.is_dir() else here.parent / "examples"
+
+
+def cmd_examples(args) -> int:
+    """Copy the examples (actuator files, the design study) into a folder, through mjeap's
+    writer: a file there that differs is refused before anything is copied, never replaced."""
+    from .io.outputs import check_outputs, replacing
+    src = examples_dir()
+    files = sorted(p.relative_to(src) for p in src.rglob("*") if p.is_file() and p.suffix in (".py", ".toml")
+                   and "__pycache__" not in p.parts)
+    if not files:
+        raise ParameterError("examples", str(src), "the examples installed with mjeap", "none found")
+    dest = Path(args.dir)
+    named = {f"DIR ({f})": dest / f for f in files}
+    check_outputs(picked=named, **named)
+    for f in files:
+        t = dest / f
+        if t.is_file() and t.read_bytes() != (src / f).read_bytes():
+            raise ParameterError(f"DIR ({f})", str(t), "a folder without changed copies of the examples",
+                                 "a file of that name there differs (yours?): refused, nothing copied; choose "
+                                 "another folder or move it")
+    for f in files:
+        t = dest / f
+        if t.is_file():
+            print(f"{t}: already there", file=sys.stderr)
+            continue
+        with replacing(t, f"DIR ({f})", picked=True) as tmp:
+            tmp.write_bytes((src / f).read_bytes())
+        print(f"{t}", file=sys.stderr)
+    print(f"mjeap examples: {len(files)} files in {dest}; try: python {dest / 'design_study.py'} --help",
+          file=sys.stderr)
+    return 0
+
+
 def cmd_robot(args) -> int:
     from .robots import get
     return get(args.name).main(args.options) or 0
@@ -622,6 +661,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("name", help=ACTUATOR_HELP)
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_show)
+    p = sub.add_parser("examples", help="copy the examples (actuator files written by hand, a worked design study) "
+                       "into a folder")
+    p.add_argument("dir", help="the folder to copy them into (made if missing; a changed copy there is never replaced)")
+    p.set_defaults(func=cmd_examples)
     p = sub.add_parser("materials", help="the materials library an actuator file's layers name (mjeap.model.materials)")
     p.add_argument("name", nargs="?", help="one material in full: each property's value, unit, range and source")
     p.add_argument("--json", action="store_true", help="every property with value, unit, range and source as JSON")
