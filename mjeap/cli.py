@@ -284,7 +284,8 @@ def cmd_rollout(args) -> int:
     params = _params(args.param)
     r = rollout(scene, args.voltage, args.duration, drive=args.drive, drive_params=params,
                 initial_curvature=args.initial_curvature, rrd=args.rrd, csv_path=args.csv,
-                progress=None if not args.quiet else False, engine=args.engine, max_steps=args.max_steps,
+                progress=False if args.quiet else ("lines" if args.progress else None), engine=args.engine,
+                max_steps=args.max_steps,
                 accuracy=args.accuracy, estimate_error=args.estimate_error)
     summary = {"actuator": scene.actuator.id, "actuator_file": scene.actuator.source_file,
                "drive": r.meta["drive"], "engine": r.meta["engine"],
@@ -697,14 +698,20 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--max-steps", type=int, default=None,
                    help="refuse runs of more steps than this (default 20,000,000: minutes of work)")
     p.add_argument("--engine", choices=ENGINES, default="auto",
-                   help="'loop' (Python lockstep), 'threaded' (mujoco.rollout; open-loop drives only) or "
-                        "'auto' (threaded where it applies; default)")
+                   help="'native' (the drive compiled into the model, on mujoco.rollout), 'threaded' "
+                        "(mujoco.rollout, the drive's moments precomputed: open-loop drives only), 'loop' (Python "
+                        "lockstep, any drive), 'warp' (MuJoCo Warp, a GPU) or 'auto' (default: the first of "
+                        "native, threaded, loop that applies; the summary's engine_reason says why)")
     p.add_argument("--accuracy", type=float, default=None,
                    help="largest error of the tip curvature relative to its swing (1e-5 to 0.2): segments, "
                         "integrator and timestep are chosen for it and the error is estimated (mjeap.simulation.accuracy)")
     p.add_argument("--estimate-error", action="store_true",
                    help="without --accuracy: estimate this model's error with a coarser companion run")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    shown = p.add_mutually_exclusive_group()
+    shown.add_argument("--quiet", action="store_true", help="no progress (default: a bar on a terminal once the run "
+                       "has lasted 2 s)")
+    shown.add_argument("--progress", action="store_true", help="one line per 10 %% of the simulated time on stderr "
+                       "(for logs and batch jobs)")
     p.set_defaults(func=cmd_rollout)
     from .robots import names as robot_names
     p = sub.add_parser("robot", help=f"run a robot's experiment (mjeap.robots): {', '.join(robot_names())}",

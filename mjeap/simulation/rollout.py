@@ -59,7 +59,7 @@ def rollout(scene: Union[Scene, str, Path],  voltage: Union[str, Waveform, calla
             drive: Union[str, "object", None] = None, drive_params: Optional[dict] = None,
             initial_curvature: float = 0.0, rrd: Union[str, Path, None] = None,
             csv_path: Union[str, Path, None] = None, sample_interval: Optional[float] = None,
-            progress: Optional[bool] = None, check_every: int = 100, controller=None,
+            progress: Union[bool, str, None] = None, check_every: int = 100, controller=None,
             engine: str = "auto", max_steps: Optional[int] = None, accuracy: Optional[float] = None,
             estimate_error: bool = False, error_model=None,
             stop_when_periodic: Optional[float] = None, metrics: Optional[Sequence[str]] = None) -> RolloutResult:
@@ -93,6 +93,9 @@ def rollout(scene: Union[Scene, str, Path],  voltage: Union[str, Waveform, calla
     target applies to these metrics of the run (peak_to_peak, returns, ...), each relative
     to its own scale, not to the trajectory; slow questions then take steps far beyond the
     modes' resolution (:mod:`mjeap.simulation.metric_accuracy`).
+
+    ``progress``: None (default: a bar on a terminal once the run has lasted 2 s), True, False
+    or ``"lines"`` (one line per 10 % of the simulated time, for logs; :mod:`mjeap.engines.progress`).
 
     ``stop_when_periodic`` (relative tolerance, periodic waveforms): the run stops at the
     first period boundary, from the third, where its last period repeats the one before
