@@ -448,8 +448,11 @@ def add_scene_args(p: argparse.ArgumentParser) -> None:
                    help=f"number of segments (>= 2; default {DEFAULT_SEGMENTS}; chosen by --accuracy where given)")
     p.add_argument("--representation", choices=REPRESENTATIONS, default="hinge")
     p.add_argument("--payload", help="tip payload MASS@POSITION[,point|,r=RADIUS|,I=INERTIA], e.g. 12.6mg@6.27mm "
-                   "(NdFeB sphere) or 12.6mg@6.27mm,point (no rotary inertia)")
-    p.add_argument("--orientation", choices=ORIENTATIONS, default="horizontal")
+                   "(NdFeB sphere) or 12.6mg@6.27mm,point (no rotary inertia); gravity loads it in the bending "
+                   "plane only with --orientation up or down")
+    p.add_argument("--orientation", choices=ORIENTATIONS, default="horizontal",
+                   help="horizontal (default: the bending plane horizontal, gravity across the width, out of the "
+                        "bending plane), up (the beam against gravity) or down (hanging along it)")
     p.add_argument("--timestep", type=float, help="timestep in s (default: chosen from the model)")
     p.add_argument("--integrator", choices=list(INTEGRATORS), default=None,
                    help="default: the representation's own (implicitfast; the rod: discrete)")
