@@ -753,9 +753,9 @@ def main(argv=None):
 
     def emit():
         text = json.dumps(out, indent=2)
-        if args.json:    # written after every benchmark: nothing measured is lost
-            Path(args.json).parent.mkdir(parents=True, exist_ok=True)
-            Path(args.json).write_text(text)
+        if args.json:    # written after every benchmark: nothing measured is lost (mjeap's one writer)
+            from mjeap.io.outputs import write_text
+            write_text(args.json, text, "--json")
         return text
 
     for name in BENCHMARKS:

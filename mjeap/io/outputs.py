@@ -607,6 +607,14 @@ def _read_only(folder) -> bool:
         return False
 
 
+def write_text(path, text: str, name: str = "path", picked: bool = False) -> Path:
+    """Write ``text`` (UTF-8) to ``path`` through :func:`replacing`: whole or not at all,
+    never through a link, a stream written through; the path returned."""
+    with replacing(path, name, picked) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+    return Path(path)
+
+
 def appending(path, name: str = "path") -> int:
     """A descriptor appending to output ``path`` (a sweep's CSV, one whole row at a time):
     a regular file is opened without following a link (created if none), a stream is
