@@ -778,15 +778,16 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0, help="seed of the starts / the evolution")
     p.add_argument("--max-evaluations", type=int, default=400, help="at most this many evaluations (default 400)")
     p.add_argument("--out", default="out/optimize",
-                   help="folder for result.json, evaluations.csv (a rerun reads it as a cache) and optimum.toml")
+                   help="folder for result.json, evaluations.csv (a rerun reads it as a cache) and optimum.toml "
+                        "(least-infeasible.toml where no point meets the constraints)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_optimize)
     p = sub.add_parser("identify", help="fit the papers' models to measured data (CSV with a header)")
     isub = p.add_subparsers(dest="what", required=True)
-    q = isub.add_parser("step", help="seed 000: transfer function from a curvature step response")
+    q = isub.add_parser("step", help="Dadras 2021 eqs. 7-8: transfer function from a curvature step response")
     q.add_argument("file")
     q.add_argument("--voltage", type=float, required=True, help="step amplitude (V)")
-    q.add_argument("--t-step", type=float, default=0.0, help="time of the step (s)")
+    q.add_argument("--t-step", type=float, default=0.0, help="time of the step (s; within the data's time span)")
     q.add_argument("--time-column", default="time")
     q.add_argument("--curvature-column", default="tip_curvature")
     q.add_argument("--actuator", help="catalog id or actuator file (.toml) to put the identified rc-relaxation "
@@ -795,7 +796,7 @@ def build_parser() -> argparse.ArgumentParser:
                    help="with --actuator: an rc-relaxation parameter the step does not identify (capacitance)")
     q.add_argument("--out", help=f"with --actuator: the identified actuator file (default {IDENTIFIED})")
     q.set_defaults(func=cmd_identify_step)
-    q = isub.add_parser("hinges", help="seed 001: joint stiffness and damping from a tip trajectory")
+    q = isub.add_parser("hinges", help="Mutlu 2013: joint stiffness and damping from a tip trajectory")
     add_scene_args(q)
     q.add_argument("file")
     q.add_argument("--voltage", required=True, help="the waveform applied during the measurement")

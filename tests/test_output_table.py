@@ -8,8 +8,8 @@ planted at FOLDER/NAME). A new command (``mjeap frf``, ``optimize --pareto``'s f
 line here and meets every target.
 
 :data:`TARGETS`: a character device, a FIFO nobody reads, a planted symbolic link, a path under
-/proc and under /sys, a read-only mount, a full disk, one of the run's own inputs (and a hard
-link of it). Each is refused before any work with one line (``mjeap: error: ...``, exit 2),
+/proc and under /sys, a read-only mount, a full disk, a full device (/dev/full: every write
+ENOSPC), one of the run's own inputs (and a hard link of it). Each is refused before any work with one line (``mjeap: error: ...``, exit 2),
 never a traceback, and left as it was; a device under a name the user gives is written
 through (exit 0) and stays a device. Each row reproduces a failure of the audit on the code
 before this change (symlinks followed at picked names, inputs overwritten, tracebacks under
@@ -92,6 +92,9 @@ COMMANDS = {
     "validate (EXPERIMENT.rrd)": Command(lambda o, f: [*VALIDATE, o], picked="mechanics-section.rrd"),
     "robot --out": Command(lambda o, f: ["robot", "robobee-wing", "--quick", "--out", o], slow=True),
     "examples DIR": Command(lambda o, f: ["examples", o], picked="design_study.py"),
+    "scripts/stability_map.py (report.md)": Command(lambda o, f: ["--out", o, "--masses", "2", "--amplitudes", "1",
+                                                                 "--periods", "1", "--executor", "serial"],
+                                                    script="scripts/stability_map.py", picked="report.md", slow=True),
     "scripts/bench.py --json": Command(lambda o, f: ["--only", "models", "--min-seconds", "0.001", "--json", o],
                                        script="scripts/bench.py", slow=True),
     "examples/design_study.py --png": Command(lambda o, f: ["--png", o], script="examples/design_study.py",
@@ -137,6 +140,15 @@ def _device(tmp, where, cmd):
     os.mknod(where, stat.S_IFCHR | 0o666, os.makedev(1, 3))          # /dev/null's numbers
     return Planted(where, lambda: stat.S_ISCHR(os.lstat(where).st_mode), accepted=cmd.picked is None,
                    message="character device")
+
+
+def _full_device(tmp, where, cmd):
+    if not ROOT_ONLY:
+        pytest.skip("making a device node needs root")
+    where.parent.mkdir(parents=True, exist_ok=True)
+    os.mknod(where, stat.S_IFCHR | 0o666, os.makedev(1, 7))          # /dev/full's: every write is ENOSPC
+    return Planted(where, lambda: stat.S_ISCHR(os.lstat(where).st_mode),
+                   message="No space left on device" if cmd.picked is None else "character device")
 
 
 def _fifo(tmp, where, cmd):
@@ -187,7 +199,7 @@ def _full(tmp, where, cmd):
                    message="No space left on device")       # no lock, temporary or part left
 
 
-TARGETS = {"device node": _device, "FIFO": _fifo, "planted link": _link, "/proc": _proc, "/sys": _sys,
+TARGETS = {"device node": _device, "full device": _full_device, "FIFO": _fifo, "planted link": _link, "/proc": _proc, "/sys": _sys,
            "read-only mount": _read_only, "full disk": _full, "an input": None, "an input's hard link": None}
 
 
