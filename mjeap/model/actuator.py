@@ -4,6 +4,7 @@ Derived quantities (neutral axis, EI, mass per length) come from
 :func:`mjeap.model.section.multilayer_section` only."""
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass, field
 from typing import Dict, Optional, Tuple
 
@@ -165,6 +166,10 @@ PLAUSIBLE = {"length": (10e-6, 1.0), "width": (1e-6, 1.0), "thickness": (10e-9, 
 MIN_SLENDERNESS = 5.0
 
 
+#: the actuators whose implausible sizes were told (by id; the entry goes with the actuator)
+_WARNED: "weakref.WeakValueDictionary" = weakref.WeakValueDictionary()
+
+
 def check_geometry(act: "Actuator", where: Optional[str] = None) -> None:
     """The sizes of ``act`` against each other and against physics (``where``: the prefix
     of the keys named, e.g. the file): a ParameterError where the shape is no beam at all
@@ -189,6 +194,10 @@ def check_geometry(act: "Actuator", where: Optional[str] = None) -> None:
     if total >= p.length:
         raise ParameterError(f"{pre}layers (total thickness)", total, f"a stack thinner than the beam's length "
                              f"{p.length:.4g} m", "a bare number is SI")
+
+    if _WARNED.get(id(act)) is act:          # told once per actuator (a file read, then its Scene built)
+        return
+    _WARNED[id(act)] = act
 
     def warn(key, value, text):
         warnings.warn(f"{key} = {value:.4g} m {text}", GeometryWarning, stacklevel=4)
