@@ -226,7 +226,10 @@ def _run(cmd: Command, argv, capsys, cwd: Path):
                            timeout=600, cwd=str(cwd))
         return p.returncode, p.stderr
     capsys.readouterr()
-    code = main(argv)
+    try:
+        code = main(argv)
+    except SystemExit as e:                          # argparse's refusal of a bad argument: usage and one line
+        code = e.code
     return code, capsys.readouterr().err
 
 
