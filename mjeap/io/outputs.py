@@ -69,7 +69,7 @@ def _stat_kind(mode: int) -> str:
 
 #: the errors of a write the disk or the system refused (one line, never a traceback)
 WRITE_ERRORS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EPERM, errno.EACCES, errno.EROFS, errno.EIO, errno.EFBIG,
-                          errno.ENXIO, errno.EPIPE, errno.EBADF, errno.EINVAL})
+                          errno.ENXIO})
 _DESCRIPTOR = re.compile(r"/(?:dev/fd|proc/self/fd|proc/(\d+)/fd)/(\d+)")
 _STANDARD = {"/dev/stdout": 1, "/dev/stderr": 2}
 
