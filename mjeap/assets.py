@@ -47,14 +47,23 @@ def asset_name(actuator_id: str, representation: str) -> str:
 def path(actuator_id: str, representation: str = "hinge") -> Path:
     """The shipped model file of a catalog actuator in a representation (its drive compiled
     in where it has a native form; seconds, mm, mg): for ``mujoco.MjModel.from_xml_path``
-    or ``python -m mujoco.viewer --mjcf=...``."""
+    or ``python -m mujoco.viewer --mjcf=...``. Only a file the installed MuJoCo loads is
+    handed out: a representation it cannot build (the cable on MuJoCo 4.x, which removed
+    the cable plugin; the rod on 3.x) is refused with the reason (the file stays in the
+    wheel for the other MuJoCo)."""
+    from .model.mjcf import BUILDERS
     if actuator_id not in CATALOG:
         raise UnknownNameError("actuator", actuator_id, sorted(CATALOG))
     if representation not in REPRESENTATIONS:
         raise ParameterError("representation", representation, " or ".join(map(repr, REPRESENTATIONS)))
+    have = sorted(r for a, r in iter_assets() if a == actuator_id and BUILDERS[r].unavailable_reason() is None)
+    why = BUILDERS[representation].unavailable_reason()
+    if why is not None:
+        raise ParameterError("representation", representation, " or ".join(map(repr, have)),
+                             f"the shipped {asset_name(actuator_id, representation)} does not load on this MuJoCo: "
+                             f"{why}")
     p = ASSET_DIR / asset_name(actuator_id, representation)
     if not p.is_file():
-        have = sorted(r for a, r in iter_assets() if a == actuator_id)
         raise ParameterError("representation", representation, " or ".join(map(repr, have)),
                              f"no shipped {representation} file of {actuator_id}")
     return p

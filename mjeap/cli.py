@@ -10,7 +10,7 @@ from typing import List, Optional
 
 import numpy as np
 
-from .errors import ParameterError
+from .errors import ParameterError, printable
 from .io.commandline import arg_number, run_command
 
 
@@ -28,16 +28,18 @@ def cmd_list(args) -> int:
 
 def _actuator(name):
     """The actuator a command names (catalog id or file), read before any work; a layer value
-    outside its material's range (RangeWarning) is told as one line, ``mjeap: warning: ...``."""
+    outside its material's range (RangeWarning) or a size outside a plausible one
+    (GeometryWarning) is told as one line, ``mjeap: warning: ...``."""
     import warnings
+    from .model.actuator import GeometryWarning
     from .model.catalog import get_actuator
     from .model.materials import RangeWarning
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always")
         act = get_actuator(name)
     for w in caught:
-        if issubclass(w.category, RangeWarning):
-            print(f"mjeap: warning: {w.message}", file=sys.stderr)
+        if issubclass(w.category, (RangeWarning, GeometryWarning)):
+            print(f"mjeap: warning: {printable(w.message)}", file=sys.stderr)
         else:
             warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
     return act
@@ -93,7 +95,8 @@ def describe(name: str) -> dict:
         layers.append({
             "name": l.name, "material": l.material,
             "thickness": (l.thickness, "m", l.provenance("thickness")),
-            "width": (l.width if l.width is not None else "planform", "m", l.provenance("width")),
+            "width": (l.width if l.width is not None else "planform", "m",
+                      l.provenance("width") if l.width is not None else "the planform's width"),
             "youngs_modulus": (l.youngs_modulus, "Pa", l.provenance("youngs_modulus")),
             "poisson_ratio": (l.poisson_ratio, "-", l.provenance("poisson_ratio")),
             "density": (l.density, "kg/m^3", l.provenance("density")),
@@ -145,11 +148,23 @@ def describe(name: str) -> dict:
     }
 
 
+def _printable_tree(x):
+    """``x`` (dicts, lists, tuples of values) with every string :func:`~mjeap.errors.printable`."""
+    if isinstance(x, str):
+        return printable(x)
+    if isinstance(x, dict):
+        return {printable(k): _printable_tree(v) for k, v in x.items()}
+    if isinstance(x, (list, tuple)):
+        return type(x)(_printable_tree(v) for v in x)
+    return x
+
+
 def cmd_show(args) -> int:
     d = describe(args.name)
-    if args.json:
+    if args.json:                      # JSON escapes control characters itself (and all non-ASCII)
         print(json.dumps(d, indent=2, default=str))
         return 0
+    d = _printable_tree(d)             # every string from the user's file, safe on a terminal
     for w in d["warnings"]:
         print(f"mjeap: warning: {w}", file=sys.stderr)
     print(f"{d['id']}: {d['title']}\n  source: {d['document']}\n  file: {d['file']}\n\nlayers (bottom to top):")
@@ -252,12 +267,17 @@ def _scene_from_args(args, units=None):
 
 def cmd_mjcf(args) -> int:
     """The driven model file (mm, mg, s; actuator 'drive' in V where the drive compiles in)."""
+    from .io.outputs import check_outputs
     from .simulation.model_file import model_file
+    from .simulation.scene import input_files
     from .units import REAL_TIME_UNITS
+    to_file = args.output not in (None, "-")
+    if to_file:                                    # before any work: never a link, never the actuator file
+        check_outputs(inputs=input_files([args.name]), **{"--output": args.output})
     scene = _scene_from_args(args, REAL_TIME_UNITS)
     f = model_file(scene)
     xml = f"<!-- {scene.actuator.id}: {f.note} Units: {scene.units.describe()}. -->\n" + f.spec.to_xml()
-    if args.output in (None, "-"):
+    if not to_file:
         sys.stdout.write(xml)
     else:
         from .io.outputs import replacing
@@ -293,11 +313,16 @@ def cmd_rollout(args) -> int:
             if given is not None:
                 raise ParameterError(flag, given, f"no {flag} with --accuracy (the target chooses the model and "
                                      "estimates its error)")
+    from .io.outputs import check_outputs
+    from .simulation.scene import input_files
+    # before any work (the scene's build too): never a link, never the actuator file or the waveform's CSV
+    check_outputs(inputs=input_files([args.name], [args.voltage]), rrd=args.rrd, csv_path=args.csv)
     scene = _scene_from_args(args)
     params = _params(args.param)
     r = rollout(scene, args.voltage, args.duration, drive=args.drive, drive_params=params,
                 initial_curvature=args.initial_curvature, rrd=args.rrd, csv_path=args.csv,
-                progress=None if not args.quiet else False, engine=args.engine, max_steps=args.max_steps,
+                progress=False if args.quiet else ("lines" if args.progress else None), engine=args.engine,
+                max_steps=args.max_steps,
                 accuracy=args.accuracy, estimate_error=args.estimate_error)
     summary = {"actuator": scene.actuator.id, "actuator_file": scene.actuator.source_file,
                "drive": r.meta["drive"], "engine": r.meta["engine"],
@@ -362,7 +387,9 @@ def cmd_frf(args) -> int:
     plot = _report_extra()
     if plot:
         paths["--out (frf.png)"] = folder / "frf.png"
-    check_outputs(**paths)
+    from .model.actuator_file import is_actuator_file
+    # names mjeap picks in --out: regular files or none, never a link, never the actuator file
+    check_outputs(inputs={"actuator file": args.name if is_actuator_file(args.name) else None}, picked=paths, **paths)
     scene = _scene_from_args(args)
     r = frf.frequency_response(scene, f0, f1, n, offset=args.offset, drive=args.drive, drive_params=_params(args.param))
     out = r.summary()
@@ -370,7 +397,7 @@ def cmd_frf(args) -> int:
                     "png": str(folder / "frf.png") if plot else "not written: the report extra (matplotlib) is not "
                                                                  "installed (pip install 'mjeap[report]')"}
     frf.write_frf(r, paths["--out (frf.csv)"])
-    with replacing(paths["--out (frf.json)"], "--out (frf.json)") as tmp:
+    with replacing(paths["--out (frf.json)"], "--out (frf.json)", picked=True) as tmp:
         tmp.write_text(json.dumps(out, indent=2, default=float), encoding="utf-8")
     if plot:
         frf.plot_frf(r, folder / "frf.png")
@@ -384,34 +411,44 @@ def cmd_frf(args) -> int:
 IDENTIFIED = "out/identified.toml"
 
 
-def _identified_out(args, act) -> str:
-    """The identified file's path (--out, default IDENTIFIED), checked before any work: a
-    writable path other than the actuator file it comes from (a hand-written file's comments
-    and units would be lost)."""
-    from .io.outputs import check_outputs
+def _identified_out(args, act, stack, data=()) -> str:
+    """The identified file's path (--out, default IDENTIFIED: a name mjeap picks), checked and
+    locked for the run before any work (``stack``: an ExitStack holding the lock): a
+    writable path other than the run's inputs, the actuator file it comes from (a
+    hand-written file's comments and units would be lost) and the data file (the
+    measurements, ``data``: (name, path) pairs). A second identify on the same --out is
+    refused at once."""
+    from .io.outputs import run_guard
     out = args.out or IDENTIFIED
-    if act.source_file and Path(out).resolve() == Path(act.source_file).resolve():
-        raise ParameterError("--out", out, f"a path other than the actuator file {act.source_file}",
-                             "it would replace the hand-written file, and its comments and units with it")
-    check_outputs(**{"--out": out})
+    inputs = [("actuator file", act.source_file if act is not None else None), *data]
+    stack.enter_context(run_guard(inputs=inputs, picked=() if args.out else ("--out",), **{"--out": out}))
     return out
 
 
 def _write_identified(act, out: str) -> str:
     """Write ``act`` to ``out`` whole or not at all (mjeap.io.outputs.replacing), once its
-    drive was built on it (an identified value the drive refuses is never written)."""
+    drive was built on it (an identified value the drive refuses is never written) and its
+    text read back as an actuator file (what cannot be read back is never put in place)."""
     from .drives import make_drive
     from .io.outputs import replacing
     from .model.actuator_file import actuator_toml
     from .simulation.scene import Scene
+    from .model.actuator_file import read_actuator
     make_drive(None, Scene(act, segments=2, gravity=False))
     text = actuator_toml(act)
-    with replacing(out, "--out") as tmp:
+    with replacing(out, "--out", picked=out == IDENTIFIED) as tmp:
         tmp.write_text(text, encoding="utf-8")
+        read_actuator(tmp.with_name(tmp.name))   # what is written reads back, or it is not put in place
     return out
 
 
 def cmd_identify_step(args) -> int:
+    from contextlib import ExitStack
+    with ExitStack() as stack:
+        return _identify_step(args, stack)
+
+
+def _identify_step(args, stack) -> int:
     from .analysis.identify import fit_step_response, given_rows, read_columns, step_actuator, step_rows
     from .analysis.identify import check_identification
     act = given = None
@@ -420,7 +457,7 @@ def cmd_identify_step(args) -> int:
         check_identification(act, "step")
         given = given_rows(_params(args.param), "mjeap identify step")
         step_rows(act, given)
-        out_path = _identified_out(args, act)
+        out_path = _identified_out(args, act, stack, [("data file", args.file)])
     else:
         for flag, v in (("--out", args.out), ("--param", args.param)):
             if v is not None:
@@ -453,12 +490,18 @@ def cmd_identify_hinges(args) -> int:
     """The beam's stiffness scale (EI(x) kept proportional to the file's), mass scale and
     damping ratio fitted to a tip trajectory with the file's own model
     (:mod:`mjeap.analysis.file_fit`); the identified file is the model that was fitted."""
+    from contextlib import ExitStack
+    with ExitStack() as stack:
+        return _identify_hinges(args, stack)
+
+
+def _identify_hinges(args, stack) -> int:
     from .analysis import file_fit, identify as ident
     scene = _scene_from_args(args)
     params = _params(args.param)
     given = ident.given_rows(params, "mjeap identify hinges")
     ident.file_drive_rows(scene.actuator, args.drive, given)        # checked before the fit, as is --out
-    out_path = _identified_out(args, scene.actuator)
+    out_path = _identified_out(args, scene.actuator, stack, [("data file", args.file)])
     d = ident.read_columns(args.file, [args.time_column, args.tip_column],
                            units={args.time_column: "s", args.tip_column: "m"})
     t, y = d[args.time_column], d[args.tip_column]
@@ -490,6 +533,12 @@ def cmd_identify_piezo(args) -> int:
     """A piezo bender's coupling, stiffness or tip mass, damping ratio, capacitance and
     resistance fitted to stroke, tip-FRF and impedance data (or a published resonance) with
     the file's own small-signal model (:mod:`mjeap.analysis.piezo_fit`)."""
+    from contextlib import ExitStack
+    with ExitStack() as stack:
+        return _identify_piezo(args, stack)
+
+
+def _identify_piezo(args, stack) -> int:
     from .analysis import file_fit, identify as ident, piezo_fit as pf
     from .analysis.frf import parse_frequency
     if not any((args.stroke, args.frf, args.impedance, args.resonance)):
@@ -500,7 +549,8 @@ def cmd_identify_piezo(args) -> int:
     ident.check_identification(scene.actuator, "piezo")
     given = ident.given_rows(_params(args.param), "mjeap identify piezo")
     ident.file_drive_rows(scene.actuator, None, given)
-    out_path = _identified_out(args, scene.actuator)
+    out_path = _identified_out(args, scene.actuator, stack, [(f"--{k} file", getattr(args, k))
+                                                             for k in ("stroke", "frf", "impedance")])
     data = pf.PiezoData(
         stroke=None if args.stroke is None else pf.read_stroke(args.stroke, args.voltage_column, args.stroke_column),
         frf=None if args.frf is None else pf.read_frf(args.frf),
@@ -551,8 +601,11 @@ def add_scene_args(p: argparse.ArgumentParser) -> None:
                    help=f"number of segments (>= 2; default {DEFAULT_SEGMENTS}; chosen by --accuracy where given)")
     p.add_argument("--representation", choices=REPRESENTATIONS, default="hinge")
     p.add_argument("--payload", help="tip payload MASS@POSITION[,point|,r=RADIUS|,I=INERTIA], e.g. 12.6mg@6.27mm "
-                   "(NdFeB sphere) or 12.6mg@6.27mm,point (no rotary inertia)")
-    p.add_argument("--orientation", choices=ORIENTATIONS, default="horizontal")
+                   "(NdFeB sphere) or 12.6mg@6.27mm,point (no rotary inertia); gravity loads it in the bending "
+                   "plane only with --orientation up or down")
+    p.add_argument("--orientation", choices=ORIENTATIONS, default="horizontal",
+                   help="horizontal (default: the bending plane horizontal, gravity across the width, out of the "
+                        "bending plane), up (the beam against gravity) or down (hanging along it)")
     p.add_argument("--timestep", type=float, help="timestep in s (default: chosen from the model)")
     p.add_argument("--integrator", choices=list(INTEGRATORS), default=None,
                    help="default: the representation's own (implicitfast; the rod: discrete)")
@@ -597,10 +650,35 @@ def _sweep_values(spec: str, random: bool, actuator=None):
     return name, [to_value(name, v.strip(), actuator) for v in rhs.split(",")]
 
 
+def _once(flag: str, specs, form: str = "NAME=VALUE") -> dict:
+    """``NAME=VALUE`` options (``--set``, ``--vary``) as name -> value text, before any work:
+    each NAME once (a repeated one would silently keep the last), none empty."""
+    out = {}
+    for spec in specs or []:
+        name, sep, rhs = spec.partition("=")
+        name = name.strip()
+        if not sep or not name:
+            raise ParameterError(flag, spec, form)
+        if name in out:
+            raise ParameterError(flag, spec, f"each NAME once ({name} is given twice: {flag} {name}={out[name]} "
+                                 f"and {flag} {spec})")
+        out[name] = rhs.strip()
+    return out
+
+
+def _distinct(vary: dict, fixed: dict) -> None:
+    """A name varied (--vary) is not also fixed (--set)."""
+    both = [n for n in vary if n in fixed]
+    if both:
+        raise ParameterError("--set", f"{both[0]}={fixed[both[0]]}", f"a setting that is not also varied "
+                             f"(--vary {both[0]}=...)")
+
+
 def cmd_sweep(args) -> int:
     from .studies import sweep
     from .studies.parameters import to_value
-    raw = dict(kv.partition("=")[::2] for kv in (args.set or []))
+    raw = _once("--set", args.set)
+    _distinct(_once("--vary", args.vary, "NAME=a,b,c or NAME=lo:hi:n (grid) or NAME=lo..hi (with --random)"), raw)
     actuator = raw.get("actuator", sweep.PARAMETERS["actuator"])
     values = dict(_sweep_values(v, args.random is not None, actuator) for v in (args.vary or []))
     if not values:
@@ -640,13 +718,13 @@ def cmd_sweep(args) -> int:
 def cmd_optimize(args) -> int:
     from .studies.optimize import optimize
     from .studies.parameters import to_value
-    vary = {}
-    for spec in args.vary or []:
-        name, sep, rhs = spec.partition("=")
-        if not sep or not name.strip() or not rhs.strip():
-            raise ParameterError("--vary", spec, "NAME=LOW:HIGH, e.g. actuator.length=5mm:15mm")
-        vary[name.strip()] = rhs.strip()
-    base = {k: to_value(k, v, args.name) for k, v in (kv.partition("=")[::2] for kv in (args.set or []))}
+    vary = _once("--vary", args.vary, "NAME=LOW:HIGH, e.g. actuator.length=5mm:15mm")
+    for name, rhs in vary.items():
+        if not rhs:
+            raise ParameterError("--vary", f"{name}=", "NAME=LOW:HIGH, e.g. actuator.length=5mm:15mm")
+    raw = _once("--set", args.set)
+    _distinct(vary, raw)
+    base = {k: to_value(k, v, args.name) for k, v in raw.items()}
     r = optimize(args.name, vary, maximize=args.maximize, minimize=args.minimize, subject_to=args.subject_to or (),
                  voltage=args.voltage, duration=args.duration, base=base,
                  metrics=[m for m in (args.metrics or "").split(",") if m], method=args.method, starts=args.starts,
@@ -688,6 +766,45 @@ def cmd_view(args) -> int:
     return 0
 
 
+def examples_dir() -> Path:
+    """The examples as installed with the wheel (the package ``mjeap.examples_files``, mapped
+    to the repository's ``examples`` by pyproject.toml), else the repository's folder."""
+    here = Path(__file__).resolve().parent
+    installed = here / "examples_files"
+    return installed if installed.is_dir() else here.parent / "examples"
+
+
+def cmd_examples(args) -> int:
+    """Copy the examples (actuator files, the design study) into a folder, through mjeap's
+    writer: a file there that differs is refused before anything is copied, never replaced."""
+    from .io.outputs import check_outputs, replacing
+    src = examples_dir()
+    files = sorted(p.relative_to(src) for p in src.rglob("*") if p.is_file() and p.suffix in (".py", ".toml", ".csv")
+                   and "__pycache__" not in p.parts)
+    if not files:
+        raise ParameterError("examples", str(src), "the examples installed with mjeap", "none found")
+    dest = Path(args.dir)
+    named = {f"DIR ({f})": dest / f for f in files}
+    check_outputs(picked=named, **named)
+    for f in files:
+        t = dest / f
+        if t.is_file() and t.read_bytes() != (src / f).read_bytes():
+            raise ParameterError(f"DIR ({f})", str(t), "a folder without changed copies of the examples",
+                                 "a file of that name there differs (yours?): refused, nothing copied; choose "
+                                 "another folder or move it")
+    for f in files:
+        t = dest / f
+        if t.is_file():
+            print(f"{t}: already there", file=sys.stderr)
+            continue
+        with replacing(t, f"DIR ({f})", picked=True) as tmp:
+            tmp.write_bytes((src / f).read_bytes())
+        print(f"{t}", file=sys.stderr)
+    print(f"mjeap examples: {len(files)} files in {dest}; try: python {dest / 'design_study.py'} --help",
+          file=sys.stderr)
+    return 0
+
+
 def cmd_robot(args) -> int:
     from .robots import get
     return get(args.name).main(args.options) or 0
@@ -701,6 +818,10 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("name", help=ACTUATOR_HELP)
     p.add_argument("--json", action="store_true")
     p.set_defaults(func=cmd_show)
+    p = sub.add_parser("examples", help="copy the examples (actuator files written by hand, a worked design study) "
+                       "into a folder")
+    p.add_argument("dir", help="the folder to copy them into (made if missing; a changed copy there is never replaced)")
+    p.set_defaults(func=cmd_examples)
     p = sub.add_parser("materials", help="the materials library an actuator file's layers name (mjeap.model.materials)")
     p.add_argument("name", nargs="?", help="one material in full: each property's value, unit, range and source")
     p.add_argument("--json", action="store_true", help="every property with value, unit, range and source as JSON")
@@ -733,14 +854,20 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--max-steps", type=int, default=None,
                    help="refuse runs of more steps than this (default 20,000,000: minutes of work)")
     p.add_argument("--engine", choices=ENGINES, default="auto",
-                   help="'loop' (Python lockstep), 'threaded' (mujoco.rollout; open-loop drives only) or "
-                        "'auto' (threaded where it applies; default)")
+                   help="'native' (the drive compiled into the model, on mujoco.rollout), 'threaded' "
+                        "(mujoco.rollout, the drive's moments precomputed: open-loop drives only), 'loop' (Python "
+                        "lockstep, any drive), 'warp' (MuJoCo Warp, a GPU) or 'auto' (default: the first of "
+                        "native, threaded, loop that applies; the summary's engine_reason says why)")
     p.add_argument("--accuracy", type=float, default=None,
                    help="largest error of the tip curvature relative to its swing (1e-5 to 0.2): segments, "
                         "integrator and timestep are chosen for it and the error is estimated (mjeap.simulation.accuracy)")
     p.add_argument("--estimate-error", action="store_true",
                    help="without --accuracy: estimate this model's error with a coarser companion run")
-    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    shown = p.add_mutually_exclusive_group()
+    shown.add_argument("--quiet", action="store_true", help="no progress (default: a bar on a terminal once the run "
+                       "has lasted 2 s)")
+    shown.add_argument("--progress", action="store_true", help="one line per 10 %% of the simulated time on stderr "
+                       "(for logs and batch jobs)")
     p.set_defaults(func=cmd_rollout)
     from .robots import names as robot_names
     p = sub.add_parser("robot", help=f"run a robot's experiment (mjeap.robots): {', '.join(robot_names())}",
@@ -810,8 +937,9 @@ def build_parser() -> argparse.ArgumentParser:
     p.add_argument("--seed", type=int, default=0, help="seed of the starts / the evolution")
     p.add_argument("--max-evaluations", type=int, default=400, help="at most this many evaluations (default 400)")
     p.add_argument("--out", default="out/optimize",
-                   help="folder for result.json, evaluations.csv (a rerun reads it as a cache), optimum.toml and, with "
-                        "the report extra, optimize.png (and pareto.csv, pareto.png)")
+                   help="folder for result.json, evaluations.csv (a rerun reads it as a cache), optimum.toml "
+                        "(least-infeasible.toml where no point meets the constraints) and, with the report extra, "
+                        "optimize.png (and pareto.csv, pareto.png)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=cmd_optimize)
     p = sub.add_parser("frf", help="small-signal frequency response (tip deflection and admittance per volt) from "
@@ -832,7 +960,7 @@ def build_parser() -> argparse.ArgumentParser:
     q = isub.add_parser("step", help="Dadras et al. 2021: transfer function from a curvature step response")
     q.add_argument("file")
     q.add_argument("--voltage", type=float, required=True, help="step amplitude (V)")
-    q.add_argument("--t-step", type=float, default=0.0, help="time of the step (s)")
+    q.add_argument("--t-step", type=float, default=0.0, help="time of the step (s; within the data's time span)")
     q.add_argument("--time-column", default="time")
     q.add_argument("--curvature-column", default="tip_curvature")
     q.add_argument("--actuator", help="catalog id or actuator file (.toml) to put the identified rc-relaxation "

@@ -7,6 +7,19 @@ import sys
 from typing import Iterable, Optional
 
 
+def printable(text) -> str:
+    """``text`` safe to print on a terminal: its control and format characters (escape
+    sequences, carriage returns, bidirectional overrides; a title in a user's file can hold
+    any) written as Python escapes (``\\x1b``, ``\\n``, ``\\u202e``), everything else as it is."""
+    import unicodedata
+    text = str(text)
+    if text.isprintable():
+        return text
+    return "".join(c if c.isprintable() or c == " " else
+                   (repr(c)[1:-1] if unicodedata.category(c) in ("Cc", "Cf", "Zl", "Zp", "Cs", "Co", "Cn")
+                    else c) for c in text)
+
+
 class MjeapError(Exception):
     """Base class of mjeap's own errors."""
 
@@ -99,10 +112,47 @@ class Terminated(KeyboardInterrupt):
     """SIGTERM, turned into the same clean stop as Ctrl-C (what was finished is written)."""
 
 
+def in_c_callback(frame) -> bool:
+    """Whether ``frame`` (a signal handler's) runs within a Python callback that MuJoCo's C
+    code called (:func:`_mujoco_warning`): an exception raised there cannot cross the C
+    frames below it, and the C++ runtime aborts the process (SIGABRT, or a segfault)."""
+    while frame is not None:
+        if frame.f_code is _mujoco_warning.__code__:
+            return True
+        frame = frame.f_back
+    return False
+
+
+def _again_soon(signum: int) -> None:
+    """Deliver ``signum`` to this process again in a moment, from a helper thread (by then
+    MuJoCo's C code has returned)."""
+    import os
+    import threading
+    t = threading.Timer(0.002, os.kill, (os.getpid(), signum))
+    t.daemon = True
+    t.start()
+
+
+def interrupt_handler(exc_type):
+    """A signal handler raising ``exc_type()`` (a KeyboardInterrupt) in the main thread, but
+    never within a callback MuJoCo's C code runs (:func:`in_c_callback`): there the signal
+    is delivered again a moment later, once the C code has returned. The one cause of the
+    crashes of a stopped run (SIGTERM or Ctrl-C while MuJoCo reported a warning)."""
+    def handler(signum, frame):
+        if in_c_callback(frame):
+            _again_soon(signum)
+            return
+        raise exc_type()
+    handler.mjeap = True
+    return handler
+
+
 class sigterm_as_interrupt:
     """Context manager: within it (in the main thread) SIGTERM raises :class:`Terminated`,
-    a KeyboardInterrupt, so a run or a sweep ends as after Ctrl-C; the previous handler is
-    restored on exit. Elsewhere (another thread, or a pool worker whose parent stops it:
+    a KeyboardInterrupt, so a run or a sweep ends as after Ctrl-C; Ctrl-C (where Python's
+    default handler has it) raises KeyboardInterrupt as before. Neither raises within a
+    callback that MuJoCo's C code runs (:func:`interrupt_handler`). The previous handlers
+    are restored on exit. Elsewhere (another thread, or a pool worker whose parent stops it:
     ``in_pool_worker``, set by :func:`mjeap.studies.sweep.worker_signals`) it does nothing: a
     worker asked to stop by its parent stops at once, it does not finish its point (nor
     hold its task queue's lock while the parent waits for it)."""
@@ -113,26 +163,34 @@ class sigterm_as_interrupt:
     def __enter__(self):
         import signal
         import threading
-        self._old = None
+        self._old = {}
         if threading.current_thread() is threading.main_thread() and not sigterm_as_interrupt.in_pool_worker:
-            def handler(signum, frame):
-                raise Terminated()
-            self._old = signal.signal(signal.SIGTERM, handler)
+            self._old[signal.SIGTERM] = signal.signal(signal.SIGTERM, interrupt_handler(Terminated))
+            if signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+                self._old[signal.SIGINT] = signal.signal(signal.SIGINT, interrupt_handler(KeyboardInterrupt))
         return self
 
     def __exit__(self, *exc):
         import signal
-        if self._old is not None:
-            signal.signal(signal.SIGTERM, self._old)
+        for s, h in self._old.items():
+            signal.signal(s, h)
         return False
 
 
 def _mujoco_warning(message: str) -> None:
     """MuJoCo's warnings as Python warnings (not stderr and a MUJOCO_LOG.TXT in the working
-    directory); its times are in the model's internal units (ms by default)."""
+    directory); its times are in the model's internal units (ms by default). MuJoCo's C
+    code calls it: nothing may raise here (the process would abort), a signal's handler
+    included (:func:`interrupt_handler`); a warning turned into an error is dropped."""
     import warnings
-    warnings.warn(f"MuJoCo: {message.strip()} (times in the model's internal units; mjeap's default unit is "
-                  "1 ms)", RuntimeWarning, stacklevel=2)
+    try:
+        warnings.warn(f"MuJoCo: {message.strip()} (times in the model's internal units; mjeap's default unit is "
+                      "1 ms)", RuntimeWarning, stacklevel=2)
+    except Exception:  # noqa: BLE001 - '-W error': an exception cannot cross MuJoCo's C frames
+        pass
+    except KeyboardInterrupt as e:       # a handler not mjeap's raised here: the signal again once C returned
+        import signal
+        _again_soon(signal.SIGTERM if isinstance(e, Terminated) else signal.SIGINT)
 
 
 def install_mujoco_warnings() -> None:

@@ -17,15 +17,17 @@ from pathlib import Path
 
 
 def main(argv=None):
-    from mjeap.io.commandline import arg_integer, parse_args
+    from mjeap.io.commandline import arg_integer, arg_output, parse_args
     from mjeap.validation.metric_claim import column_band_cases, converged, draw_cases, geometry_goldens
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--seed", type=arg_integer(0), default=36)
     ap.add_argument("--cases", type=arg_integer(1, 1000), default=40)
     ap.add_argument("--geometry", action="store_true", help="the length sweep's goldens instead of the cases'")
     ap.add_argument("--column-band", action="store_true", help="the column band's goldens instead of the cases'")
-    ap.add_argument("--out", default=None, help="default: tests/golden/metric_accuracy[_geometry|_column].json")
+    ap.add_argument("--out", default=None, type=arg_output(),
+                    help="default: tests/golden/metric_accuracy[_geometry|_column].json")
     a = parse_args(ap, argv)
+    from mjeap.io.outputs import write_text
     root = Path(__file__).resolve().parents[1]
     if a.column_band:
         out = a.out or str(root / "tests/golden/metric_accuracy_column.json")
@@ -33,12 +35,12 @@ def main(argv=None):
         for case in column_band_cases():
             goldens.append(converged(case))
             print(case.describe(), flush=True)
-        Path(out).write_text(json.dumps({"cases": goldens}, indent=1, default=float) + "\n")
+        write_text(out, json.dumps({"cases": goldens}, indent=1, default=float) + "\n", "--out")
         print(f"wrote {out}")
         return
     if a.geometry:
         out = a.out or str(root / "tests/golden/metric_accuracy_geometry.json")
-        Path(out).write_text(json.dumps(geometry_goldens(root), indent=1, default=float) + "\n")
+        write_text(out, json.dumps(geometry_goldens(root), indent=1, default=float) + "\n", "--out")
         print(f"wrote {out}")
         return
     a.out = a.out or str(root / "tests/golden/metric_accuracy.json")
@@ -46,7 +48,7 @@ def main(argv=None):
     for i, case in enumerate(draw_cases(a.seed, a.cases)):
         goldens.append(converged(case))
         print(f"{i + 1}/{a.cases} {case.describe()}", flush=True)
-    Path(a.out).write_text(json.dumps({"seed": a.seed, "cases": goldens}, indent=1, default=float) + "\n")
+    write_text(a.out, json.dumps({"seed": a.seed, "cases": goldens}, indent=1, default=float) + "\n", "--out")
     print(f"wrote {a.out}")
 
 

@@ -45,6 +45,8 @@ if __name__ == "__main__":
                          f"power_w_at_step_over_{CHECK}": check["power_w"], f"lag_deg_at_step_over_{CHECK}": check["lag_deg"]})
             print(f"{a} r={r}: P={fine['power_w']:.6e} W (/{CHECK}: {check['power_w'] / fine['power_w'] - 1:+.2e}), "
                   f"lag {fine['lag_deg']:.4f} deg ({check['lag_deg'] - fine['lag_deg']:+.4f})", flush=True)
-    OUT.write_text(json.dumps({"what": __doc__.split("\n\n")[0], "mujoco": mujoco.__version__, "refinement": FINE,
-                               "amplitude_v": AMPLITUDE, "offset_v": OFFSET, "cases": rows}, indent=1) + "\n")
+    from mjeap.io.outputs import write_text
+    write_text(OUT, json.dumps({"what": __doc__.split("\n\n")[0], "mujoco": mujoco.__version__, "refinement": FINE,
+                                "amplitude_v": AMPLITUDE, "offset_v": OFFSET, "cases": rows}, indent=1) + "\n",
+               "reference file", picked=True)
     print(OUT)

@@ -98,8 +98,9 @@ def render_one(path, png: Path, size: str = "1600x900", at_time: float = None, t
             ns = tl.start if at_time is None else int(round(at_time * 1e9))
             viewer.set_time("time", duration=ns * 1e-9, recording=rec.store_id)
         time.sleep(1.0)                           # a few frames for the views to lay out their data
-        png.parent.mkdir(parents=True, exist_ok=True)
-        viewer.save_screenshot(str(Path(png).resolve()))
+        from mjeap.io.outputs import replacing
+        with replacing(png, "png") as tmp:        # mjeap's one writer: whole, never through a link
+            viewer.save_screenshot(str(Path(tmp).resolve()))
         return png
     finally:
         _stop(proc)

@@ -12,6 +12,7 @@ gravity, internal units) as JSON.
     python scripts/unit_change_check.py [--out FILE] [--duration-scale 0.25]
 """
 import argparse
+import sys
 import json
 
 import numpy as np
@@ -63,12 +64,13 @@ def run(aid, rep, units, engine, scale, converged=False):
     return s, r.tip_curvature
 
 
-def main():
+def main(argv=None):
+    from mjeap.io.commandline import arg_output
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--out", default=None)
+    ap.add_argument("--out", default=None, type=arg_output(), help="also write the results here (JSON)")
     ap.add_argument("--duration-scale", type=float, default=1.0)
     ap.add_argument("--only", nargs="*", help="ACTUATOR:REPRESENTATION pairs (default: all)")
-    a = ap.parse_args()
+    a = ap.parse_args(argv)
     rows = []
     for aid, rep in iter_assets():
         if BUILDERS[rep].unavailable_reason() is not None or (a.only and f"{aid}:{rep}" not in a.only):
@@ -106,10 +108,11 @@ def main():
     out = {"mujoco": MUJOCO_VERSION, "duration_scale": a.duration_scale, "runs": rows,
            "worst_difference_over_swing": max(r["difference_over_swing"] for r in rows)}
     if a.out:
-        with open(a.out, "w") as f:
-            json.dump(out, f, indent=1)
+        from mjeap.io.outputs import write_text
+        write_text(a.out, json.dumps(out, indent=1), "--out")
     print("worst", out["worst_difference_over_swing"])
 
 
 if __name__ == "__main__":
-    main()
+    from mjeap.io.commandline import run_script
+    sys.exit(run_script(main))

@@ -47,11 +47,13 @@ def _machine(m) -> str:
 
 
 def _models(rows) -> str:
-    return ("**models**: MuJoCo's own stepping loop, one thread, unforced, every catalog actuator at "
-            "its default discretisation, in each representation this MuJoCo runs.\n\n" + _table(
-                ["actuator", "representation", "segments", "nv", "timestep (ms)", "steps/s", "real-time factor"],
-                [[f"`{r['actuator']}`", r["representation"], r["segments"], r["nv"], _num(1e3 * r["timestep_s"]),
-                  _num(r["steps_per_s"]), _num(r["real_time_factor"])] for r in rows]))
+    return ("**models**: every shipped model file this MuJoCo loads (`mjeap.assets.path`), as a user "
+            "plays it (`mjeap.load_mjcf`, MuJoCo's own stepping loop, one thread, its drive held off rest); "
+            "the real-time factor is simulated seconds per wall second (below 1: slower than real time in "
+            "MuJoCo's viewer).\n\n" + _table(
+                ["file", "nv", "timestep (ms)", "steps/s", "real-time factor"],
+                [[f"`{r.get('file', r['actuator'] + '_' + r['representation'] + '.xml')}`", r["nv"],
+                  _num(1e3 * r["timestep_s"]), _num(r["steps_per_s"]), _num(r["real_time_factor"])] for r in rows]))
 
 
 def _drives(rows) -> str:

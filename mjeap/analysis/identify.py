@@ -175,6 +175,14 @@ def fit_step_response(time, curvature, voltage: float, t_step: float = 0.0) -> S
     t, k = check_series(time, curvature, names=["curvature"])
     if not np.isfinite(voltage) or voltage == 0:
         raise ParameterError("voltage", voltage, "the step's non-zero amplitude in V")
+    try:
+        t_step = float(t_step)
+    except (TypeError, ValueError):
+        t_step = float("nan")
+    if not t[0] <= t_step < t[-1]:              # NaN too: a step outside the record shifts every exponential
+        raise ParameterError("t_step", t_step, f"the step's time within the data's span [{t[0]:g}, {t[-1]:g}) s",
+                             "the fit measures time from the step: a step before the record starts (or after it "
+                             "ends) scales B and C by exp(p t) and gives a wrong gain")
     sel = t >= t_step
     if sel.sum() < MIN_SAMPLES:
         raise ParameterError("t_step", t_step, f"a time leaving at least {MIN_SAMPLES} samples after it")
@@ -314,13 +322,17 @@ def file_drive_rows(act, drive: Optional[str], given: Dict[str, tuple]) -> Dict[
     (default its own): its file's own where it names that drive (another drive's are
     dropped), ``given`` over them. A name the drive does not take is refused."""
     from ..drives import default_drive_name, get_drive_class
+    from ..model.quantity import to_si
     drive = drive or default_drive_name(act)
     cls = get_drive_class(drive)
-    known = {*cls.parameter_units(), *cls.extra_parameters(None)}
+    units = cls.parameter_units()
+    known = {*units, *cls.extra_parameters(None)}
     for k, v in given.items():
         if k not in known:
             raise ParameterError("--param", f"{k}={v[0]}", f"a parameter of the {drive} drive: "
                                  f"{', '.join(sorted(known)) or 'none'}")
+        if k in units:                       # a number (NaN, inf and text refused): the file must read back
+            given = {**given, k: (to_si(v[0], units[k], f"--param {k}"), *v[1:])}
     own = dict(act.drive_parameters) if (act.drive or default_drive_name(act)) == drive else {}
     return {**own, **given}
 

@@ -104,14 +104,30 @@ def check_samples(engine: Engine, samples: Sequence, stopped_early: bool = False
 
 def run_checked(engine: Engine, scene: SceneTarget, drives: Sequence, v_steps: Sequence,
                 initial_curvatures: Sequence[float], sample_steps, samples: Sequence, **kw) -> None:
-    """``engine.run(...)`` (:meth:`Engine.run`), then its samples checked (:func:`check_samples`):
+    """``engine.run(...)`` (:meth:`Engine.run`) with its progress shown
+    (:mod:`mjeap.engines.progress`: ``progress=`` in ``kw``), then its samples checked (:func:`check_samples`):
     a plug-in engine that fills too few samples or non-finite ones is refused naming it,
     not returned as an empty or NaN result. A :class:`Decided` goes on up."""
-    try:
-        engine.run(scene, drives, v_steps, initial_curvatures, sample_steps, samples, **kw)
-    except Decided:
-        check_samples(engine, samples, stopped_early=True)
-        raise
+    from .progress import Progress
+    progress = kw.pop("progress", None)
+    total = len(v_steps[0]) * getattr(scene, "timestep", 0.0) if len(v_steps) else 0.0
+    first = samples[0] if len(samples) else None
+    what = getattr(getattr(scene, "actuator", None), "id", "run")
+    with Progress(total, f"{what} ({engine.name})", progress) as shown:
+        if first is not None and shown.mode is not False:
+            def take(t, *a, **k):       # every engine takes its samples in time order
+                first.__class__.take(first, t, *a, **k)
+                shown.at(t)
+            first.take = take
+        try:
+            engine.run(scene, drives, v_steps, initial_curvatures, sample_steps, samples, progress=False, **kw)
+        except Decided:
+            check_samples(engine, samples, stopped_early=True)
+            raise
+        finally:
+            if first is not None:
+                first.__dict__.pop("take", None)
+        shown.at(total)
     check_samples(engine, samples)
 
 

@@ -214,6 +214,11 @@ def to_waveform(voltage, duration: float):
         voltage = Waveform("step", amplitude=v, text=f"constant {v:g} V")
     if not isinstance(voltage, (str, Waveform)) and not callable(voltage):
         raise ParameterError("voltage", voltage, "a waveform text, a Waveform, a number of volts or a callable v(t)")
+    if not isinstance(voltage, (str, Waveform)):
+        why = arity_problem(voltage, 1)
+        if why is not None:
+            raise ParameterError("voltage", getattr(voltage, "__qualname__", type(voltage).__name__),
+                                 "a callable v(t) of one argument, t in s", why)
     wave = parse_waveform(voltage) if isinstance(voltage, str) else voltage
     return wave.with_duration(duration) if isinstance(wave, Waveform) else wave
 
@@ -248,6 +253,21 @@ CONTROLLER_CONTRACT = ("a callable controller(t, scene_or_system) -> voltage(s) 
                        "__call__; used when present: reset(scene_or_system, drive), interval (s), name, signals()")
 
 
+def arity_problem(fn, n: int) -> Optional[str]:
+    """Why ``fn`` cannot be called with ``n`` positional arguments (its signature), or None
+    (it can, or its signature cannot be read: a builtin)."""
+    import inspect
+    try:
+        sig = inspect.signature(fn)
+    except (TypeError, ValueError):
+        return None
+    try:
+        sig.bind(*range(n))
+    except TypeError as e:
+        return f"its signature is {sig}: {e}"
+    return None
+
+
 def check_controller(controller, voltage=None, voltage_name: str = "voltage") -> str:
     """The controller contract, one for :func:`mjeap.rollout` and :meth:`mjeap.System.rollout`,
     checked before any work; returns the controller's name.
@@ -268,6 +288,15 @@ def check_controller(controller, voltage=None, voltage_name: str = "voltage") ->
     for attr in ("reset", "signals"):
         if getattr(controller, attr, None) is not None and not callable(getattr(controller, attr)):
             raise ParameterError(f"controller.{attr}", getattr(controller, attr), f"a method, or none: {CONTROLLER_CONTRACT}")
+    # the arguments each is called with, checked before any work (not a TypeError mid-run)
+    for label, fn, args in (("controller", controller, ("t", "target")),
+                            ("controller.reset", getattr(controller, "reset", None), ("target", "drive")),
+                            ("controller.signals", getattr(controller, "signals", None), ())):
+        why = None if fn is None else arity_problem(fn, len(args))
+        if why is not None:
+            raise ParameterError(label, getattr(fn, "__qualname__", type(fn).__name__),
+                                 f"a callable taking {len(args)} positional argument{'s' * (len(args) != 1)}"
+                                 + (f" ({', '.join(args)})" if args else "") + f": {CONTROLLER_CONTRACT}", why)
     if voltage is not None:
         raise ParameterError(voltage_name, getattr(voltage, "text", voltage), "None when a controller sets the voltage")
     name = getattr(controller, "name", None)

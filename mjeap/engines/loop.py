@@ -8,7 +8,6 @@ per step anyway.
 from __future__ import annotations
 
 import math
-import sys
 import warnings
 from typing import Optional
 
@@ -18,14 +17,6 @@ import numpy as np
 from ..errors import DivergenceError
 from .base import Engine
 from .frame import Decided, controller_every, lockstep, one_voltage, reset_controller
-
-try:  # progress bars are optional
-    from tqdm import tqdm
-except ImportError:  # pragma: no cover
-    tqdm = None
-
-#: runs of more steps show a progress bar (when progress is None)
-PROGRESS_STEPS = 200_000
 
 
 def advance(model, data, drive, voltage: float, dt: float, nstep: int = 1) -> None:
@@ -115,11 +106,11 @@ class LoopEngine(Engine):
     def run(self, scene, drives, v_steps, initial_curvatures, sample_steps, samples, *, nthread=0, progress=None,
             check_every=100, controller=None, meta=None) -> None:
         (drv,), (v,), (kappa0,), (store,) = drives, v_steps, initial_curvatures, samples
-        run_loop(scene, drv, v, kappa0, sample_steps, store, progress=progress, check_every=check_every,
-                 controller=controller, meta={} if meta is None else meta)
+        run_loop(scene, drv, v, kappa0, sample_steps, store, check_every=check_every, controller=controller,
+                 meta={} if meta is None else meta)
 
 
-def run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, *, progress, check_every,
+def run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, *, check_every,
              controller, meta) -> None:
     """One lockstep run of ``scene`` with ``drv``: ``v_steps`` (V per step; a controller's
     commands are written into it), sampled at ``sample_steps`` into ``samples``."""
@@ -133,9 +124,6 @@ def run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, *, p
         reset_controller(controller, scene, drv)
         ctrl_every = controller_every(controller, dt)
         ctrl_name = meta["controller"]
-    show = (n_steps > PROGRESS_STEPS and sys.stderr.isatty()) if progress is None else progress
-    bar = tqdm(total=n_steps, unit="step", desc=f"{scene.actuator.id} {drv.name}", disable=not show,
-               leave=False) if tqdm else None
     m, d = scene.model, scene.data
     drive_step = drv.step
 
@@ -178,10 +166,8 @@ def run_loop(scene, drv, v_steps, initial_curvature, sample_steps, samples, *, p
 
     try:
         lockstep(m, d, n_steps, sample_steps, open_loop if controller is None else closed_loop, sample, check,
-                 check_every=check_every, progress=None if bar is None else bar.update)
+                 check_every=check_every)
     finally:
-        if bar is not None:
-            bar.close()
         if controller is not None:
             saturated = state["saturated"]
             meta["saturated_updates"] = int(saturated)

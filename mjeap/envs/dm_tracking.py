@@ -115,6 +115,7 @@ class CurvatureTrackingTask:
         self.reward_fn = reward_fn
         self.limiter = VoltageLimiter("the action_spec")
         self.episode = {}
+        self._signal_names = None           # the drive's signals: set at the first reset or observation
 
     @property
     def random(self) -> np.random.RandomState:
@@ -159,11 +160,13 @@ class CurvatureTrackingTask:
     def get_observation(self, physics: BeamPhysics):
         """tip_curvature (1/m), reference (1/m), tip_position (m, clamp frame), drive_state
         (SI, see drive_state_names) and current (A) where the drive reports one."""
+        if self._signal_names is None:      # before the first reset (an agent reads the specs first)
+            self._signal_names = list(physics.drive.signals())
         return observe(physics.scene, physics.drive, self.reference, self._signal_names)
 
     @property
     def drive_state_names(self):
-        return list(self._signal_names)
+        return list(self._signal_names or ())
 
     def get_reward(self, physics: BeamPhysics) -> float:
         sc = physics.scene

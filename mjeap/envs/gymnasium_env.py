@@ -159,6 +159,12 @@ class CurvatureTrackingEnv(gymnasium.Env):
         return why + (f" MuJoCo warned: {', '.join(warned)}." if warned else "")
 
     # -- the Gymnasium API -------------------------------------------------------------
+    @property
+    def dt(self) -> float:
+        """The agent's step in s (Gymnasium's MuJoCo environments' ``dt``: the model's timestep
+        times the MuJoCo steps per action): :attr:`control_timestep`."""
+        return self.control_timestep
+
     def reset(self, *, seed: Optional[int] = None, options: Optional[dict] = None):
         """Start an episode: the payload mass and initial curvature drawn from ``np_random``
         (seeded by ``seed``), the beam at rest as a uniform arc, the drive reset. ``options``

@@ -94,6 +94,12 @@ class SystemEnv(gymnasium.Env):
     def _info(self) -> dict:
         return {"time_s": self.time, "voltages_V": self.voltages.copy(), "saturated_steps": self._saturated}
 
+    @property
+    def dt(self) -> float:
+        """The agent's step in s (Gymnasium's MuJoCo environments' ``dt``: the model's timestep
+        times the MuJoCo steps per action): :attr:`control_timestep`."""
+        return self.control_timestep
+
     def reset(self, *, seed: Optional[int] = None, options: Optional[dict] = None):
         """Start an episode at the robot's start state (the seed seeds ``np_random``; the
         start itself is always the same). ``options`` takes nothing (None or {})."""

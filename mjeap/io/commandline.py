@@ -7,12 +7,16 @@ them; they import nothing above the io layer."""
 from __future__ import annotations
 
 import argparse
+import errno
 import os
 import sys
 from pathlib import Path
 from typing import Callable, List, Optional
 
-from ..errors import MjeapError, ParameterError
+from ..errors import MjeapError, ParameterError, printable
+
+#: the errors of a disk or system refusing a write: a command says them in one line
+DISK_ERRORS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EPERM, errno.EACCES, errno.EIO, errno.EFBIG})
 
 
 # ---------------------------------------------------------------- running a command
@@ -33,16 +37,23 @@ def run_command(call: Callable[[], Optional[int]], prog: str = "mjeap") -> int:
         with sigterm_as_interrupt():
             code = call()
     except MjeapError as e:
-        print(f"{prog}: error: {e}", file=sys.stderr)
+        print(f"{prog}: error: {printable(e)}", file=sys.stderr)
         for note in getattr(e, "__notes__", ()):      # e.g. an output that could not be written too
-            print(f"{prog}: error: {note}", file=sys.stderr)
+            print(f"{prog}: error: {printable(note)}", file=sys.stderr)
+        return 2
+    except OSError as e:
+        # a disk or system refusing a write outside mjeap's writer: one line, never a traceback
+        if e.errno not in DISK_ERRORS:
+            raise
+        print(f"{prog}: error: {printable(e.filename or '')}{': ' if e.filename else ''}"
+              f"{e.strerror or e}", file=sys.stderr)
         return 2
     except KeyboardInterrupt as e:
         term = isinstance(e, Terminated)
         print(f"{prog}: interrupted ({'SIGTERM' if term else 'Ctrl-C'}); stopped, outputs written so far are kept",
               file=sys.stderr)
         for note in getattr(e, "__notes__", ()):
-            print(f"{prog}: error: {note}", file=sys.stderr)
+            print(f"{prog}: error: {printable(note)}", file=sys.stderr)
         return EXIT_SIGTERM if term else EXIT_CTRL_C
     except BrokenPipeError:
         # the reader of stdout went away (``mjeap ... | head``): the outputs are written; say

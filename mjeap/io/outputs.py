@@ -1,10 +1,19 @@
-"""Files that survive a stop, a kill, a full disk or a second writer, and never replace what
-is not a regular file of ours.
+"""The one writer of every output of mjeap (its commands, its API, its scripts): files that
+survive a stop, a kill, a full disk or a second writer, never replace what is not a regular
+file of ours, never follow a link and never overwrite one of the run's inputs.
 
 * :func:`output_kind`: what a path is. A regular file (or none yet) is written whole; a
-  character device or a FIFO (``/dev/null``, ``/dev/stdout`` on a pipe, a named pipe) is a
-  stream, written through, never replaced; anything else (a directory, a block device, a
-  socket) is refused, naming the parameter.
+  character device or a FIFO (``/dev/null``, a named pipe) is a stream, written through,
+  never replaced; a name of one of this process's descriptors (``/dev/stdout``,
+  ``/dev/stderr``, ``/dev/fd/N``, ``/proc/self/fd/N``) is written through that descriptor,
+  at its offset, so a file behind a shell's ``>>`` keeps what it held. A symbolic link is
+  refused (never followed: a link planted in a shared folder cannot redirect a write), and
+  so is anything else (a directory, a block device, a socket), naming the parameter. A name
+  mjeap picks itself (``picked``: a report in an output folder) must be a regular file or
+  none: a device or FIFO there is refused too.
+* :func:`check_outputs` (before any work) refuses an output that is one of the run's
+  ``inputs`` (the same resolved path or the same inode: an actuator file, a data or
+  waveform CSV), naming both.
 * :func:`replacing`: a regular file is written to a temporary file beside it (an
   unguessable name, created exclusively) and renamed onto its path when complete and
   fsynced, so a reader sees the old file or the whole new one, never a part. A write that
@@ -17,8 +26,10 @@ is not a regular file of ours.
   lock file left by a killed one blocks nothing; the temporary it names (ours) is removed
   then, and nothing else. A released lock file is removed. A stream is held open instead
   (a FIFO's reader then sees one writer from the check to the end).
-* :func:`check_outputs` checks a run's output paths before any work; :func:`write_outputs`
-  writes each on its own at the end, one failure not stopping the others.
+* :func:`write_outputs` writes each of a run's outputs on its own at the end, one failure not
+  stopping the others; a failed write (ENOSPC, EPERM, EROFS, ...) is one line,
+  :class:`~mjeap.errors.OutputError`, the old file left whole.
+* :func:`appending` opens a file to append whole rows to (a sweep's CSV), by the same rules.
 * :func:`guarded`: a run (a stepping loop) checks and locks its outputs before any work and,
   within it, SIGTERM takes Ctrl-C's path: the run stops and writes what it simulated.
 """
@@ -37,7 +48,7 @@ import tempfile
 import threading
 from contextlib import ExitStack, contextmanager
 from pathlib import Path
-from typing import Dict, Optional
+from typing import Callable, Dict, Iterable, Mapping, Optional
 
 from ..errors import OutputError, ParameterError, sigterm_as_interrupt
 
@@ -56,32 +67,114 @@ def _stat_kind(mode: int) -> str:
     return "special file"
 
 
-def output_kind(path, name: str = "path") -> str:
-    """``"file"`` (a regular file, through any links), ``"new"`` (nothing there yet) or
-    ``"stream"`` (a character device or FIFO: written through, never replaced); anything
-    else is refused with a :class:`ParameterError` on ``name``. The path is followed as the
-    kernel does (``/dev/stdout`` is whatever fd 1 is)."""
+#: the errors of a write the disk or the system refused (one line, never a traceback)
+WRITE_ERRORS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EPERM, errno.EACCES, errno.EROFS, errno.EIO, errno.EFBIG,
+                          errno.ENXIO})
+_DESCRIPTOR = re.compile(r"/(?:dev/fd|proc/self/fd|proc/(\d+)/fd)/(\d+)")
+_STANDARD = {"/dev/stdout": 1, "/dev/stderr": 2}
+
+
+def descriptor(path) -> Optional[int]:
+    """The descriptor of this process that ``path`` names (``/dev/stdout`` 1, ``/dev/stderr``
+    2, ``/dev/fd/N``, ``/proc/self/fd/N``, ``/proc/PID/fd/N`` of this PID), else None. Such
+    a path is written through that descriptor (never reopened: reopening a file behind
+    ``>>`` would write from its start)."""
     try:
-        st = os.stat(path)
+        text = os.path.normpath(os.fspath(path))
+    except TypeError:
+        return None
+    if text in _STANDARD:
+        return _STANDARD[text]
+    m = _DESCRIPTOR.fullmatch(text)
+    if m and (m.group(1) is None or int(m.group(1)) == os.getpid()):
+        return int(m.group(2))
+    return None
+
+
+def _refused(name, path, accepted, why):
+    return ParameterError(name, str(path), accepted, why)
+
+
+def output_kind(path, name: str = "path", picked: bool = False) -> str:
+    """``"file"`` (a regular file), ``"new"`` (nothing there yet) or ``"stream"`` (a character
+    device or FIFO, or a name of one of this process's descriptors, :func:`descriptor`:
+    written through, never replaced); anything else is refused with a
+    :class:`ParameterError` on ``name``: a symbolic link (never followed), a directory, a
+    block device, a socket; with ``picked`` (a name mjeap chose itself, in an output folder)
+    a stream too."""
+    fd = descriptor(path)
+    if fd is not None and not picked:
+        try:
+            st = os.fstat(fd)
+        except OSError:
+            raise _refused(name, path, "an open stream", f"descriptor {fd} is not open in this process") from None
+        if stat.S_ISREG(st.st_mode) or stat.S_ISCHR(st.st_mode) or stat.S_ISFIFO(st.st_mode) \
+                or stat.S_ISSOCK(st.st_mode):
+            return "stream"
+        raise _refused(name, path, _STREAMS, f"descriptor {fd} is a {_stat_kind(st.st_mode)}: refused")
+    try:
+        st = os.lstat(path)
     except FileNotFoundError:
         return "new"
     except OSError as e:
-        raise ParameterError(name, str(path), "a path mjeap can write",
-                             f"cannot write {path}: {e.strerror or e}") from None
+        raise _refused(name, path, "a path mjeap can write", f"cannot write {path}: {e.strerror or e}") from None
+    if stat.S_ISLNK(st.st_mode):
+        try:
+            to = os.readlink(path)
+        except OSError:  # pragma: no cover - removed meanwhile
+            to = "?"
+        raise _refused(name, path, "a path that is not a symbolic link",
+                       f"it is a symbolic link to {to}: refused, never followed (a link planted in a shared folder "
+                       "would redirect the write); give the path it points to")
     if stat.S_ISREG(st.st_mode):
         return "file"
+    kind = _stat_kind(st.st_mode)
+    if picked:
+        raise _refused(name, path, "a regular file or none (mjeap names this file itself)",
+                       f"it is a {kind}: refused, never written through or replaced")
     if stat.S_ISCHR(st.st_mode) or stat.S_ISFIFO(st.st_mode):
         return "stream"
-    kind = _stat_kind(st.st_mode)
-    raise ParameterError(name, str(path), "a file path" if kind == "directory" else _STREAMS,
-                         f"it is a {kind}: refused, never replaced")
+    raise _refused(name, path, "a file path" if kind == "directory" else _STREAMS,
+                   f"it is a {kind}: refused, never replaced")
+
+
+def _target(path) -> Path:
+    """Where a regular file ``path`` lies: its folder resolved, its own name kept (the name
+    is never a link: :func:`output_kind`; a rename replaces a link planted later, it does
+    not follow it)."""
+    p = Path(os.path.abspath(path))
+    return Path(os.path.realpath(p.parent)) / p.name
+
+
+def _stream_stat(path):
+    fd = descriptor(path)
+    return os.fstat(fd) if fd is not None else os.stat(path)
 
 
 def _key(path, kind: str):
     if kind == "stream":
-        st = os.stat(path)
+        st = _stream_stat(path)
         return ("stream", st.st_dev, st.st_ino)
-    return Path(os.path.realpath(path))
+    return _target(path)
+
+
+def _identity(path):
+    """(resolved path, (device, inode) or None) of a path, following links (an input is
+    read through them)."""
+    fd = descriptor(path)
+    try:
+        st = os.fstat(fd) if fd is not None else os.stat(path)
+        ino = (st.st_dev, st.st_ino)
+    except (OSError, ValueError):
+        ino = None
+    return (None if fd is not None else Path(os.path.realpath(path))), ino
+
+
+def same_file(a, b) -> bool:
+    """Whether paths ``a`` and ``b`` are one file: the same resolved path, or the same inode
+    (a hard link, a descriptor's file)."""
+    (pa, ia), (pb, ib) = _identity(a), _identity(b)
+    return (pa is not None and pa == pb) or (ia is not None and ia == ib)
 
 
 # ---------------------------------------------------------------- locks and held streams
@@ -151,7 +244,17 @@ def _lock_file(target: Path, name: str, holder: str, given) -> int:
                     os.unlink(stale)
             except OSError:
                 pass
-        _write_lock(fd, holder)
+        try:
+            _write_lock(fd, holder)
+        except OSError as e:                          # a full or read-only disk: said before any work
+            if not text:
+                try:
+                    os.unlink(lock)
+                except OSError:
+                    pass
+            os.close(fd)
+            raise ParameterError(name, str(given), "a path on a disk mjeap can write",
+                                 f"cannot write its lock file {lock}: {e.strerror or e}") from None
         return fd
 
 
@@ -164,8 +267,12 @@ def _write_lock(fd: int, holder: str, temporary: Optional[str] = None) -> None:
 
 
 def _open_stream(path, name: str) -> int:
-    """An fd writing to the stream ``path``; a FIFO must have a reader now (else refused:
-    waiting for one could hang forever)."""
+    """An fd writing to the stream ``path`` (a descriptor's name: a duplicate of it, sharing
+    its offset); a FIFO must have a reader now (else refused: waiting for one could hang
+    forever)."""
+    fd = descriptor(path)
+    if fd is not None:
+        return os.dup(fd)
     fifo = stat.S_ISFIFO(os.stat(path).st_mode)
     try:
         fd = os.open(path, os.O_WRONLY | os.O_NOCTTY | os.O_CLOEXEC | (os.O_NONBLOCK if fifo else 0))
@@ -182,12 +289,13 @@ def _open_stream(path, name: str) -> int:
 
 
 @contextmanager
-def hold(path, name: str = "path", holder: str = "mjeap run"):
+def hold(path, name: str = "path", holder: str = "mjeap run", picked: bool = False):
     """Hold the lock of output ``path`` for the block (a stream: hold it open): another
     process or thread holding it is refused at once (ParameterError on ``name``, naming the
     path and the holder); the same thread may hold it again (a run's writers within the
-    run). Yields the key the path is held under."""
-    kind = output_kind(path, name)
+    run). ``picked``: a name mjeap chose (:func:`output_kind`). Yields the key the path is
+    held under."""
+    kind = output_kind(path, name, picked)
     key = _key(path, kind)
     me = (os.getpid(), threading.get_ident())
     with _held_lock:
@@ -289,32 +397,65 @@ def _write_all(fd: int, src) -> None:
                 view = view[os.write(fd, view):]
 
 
+def _write_failed(path, e: OSError) -> "OutputError":
+    """A refused write as one line, naming the path (OutputError)."""
+    return OutputError([(str(path), e.strerror or str(e))])
+
+
 @contextmanager
-def replacing(path, name: str = "path"):
+def _one_line(path):
+    """Within the block a write the system refuses (:data:`WRITE_ERRORS`: ENOSPC, EPERM,
+    EROFS, ...) is an :class:`OutputError` naming ``path``, one line."""
+    try:
+        yield
+    except OutputError:
+        raise
+    except OSError as e:
+        if e.errno not in WRITE_ERRORS:
+            raise
+        raise _write_failed(path, e) from None
+
+
+def _flush_std() -> None:
+    import sys
+    for fh in (sys.stdout, sys.stderr):
+        try:
+            fh.flush()
+        except (OSError, ValueError, AttributeError):
+            pass
+
+
+@contextmanager
+def replacing(path, name: str = "path", picked: bool = False):
     """A temporary path for the block to write, put in place when the block ends.
 
     A regular file (or none yet): the temporary lies beside ``path`` (an unguessable name,
     created exclusively, named in the path's lock so that only it is ever cleaned up), is
     fsynced and renamed onto ``path``; an existing file keeps its mode. A block that raises,
-    or a write that fails (a full disk), leaves ``path`` as it was and removes the
-    temporary: a reader sees the old file or the whole new one. A stream (a character
-    device or FIFO) gets the finished bytes written through, and is never replaced. The
-    path's lock is held meanwhile (:func:`hold`); SIGINT and SIGTERM are delivered after."""
-    kind = output_kind(path, name)
+    or a write that fails (a full disk: an :class:`OutputError`, one line), leaves ``path``
+    as it was and removes the temporary: a reader sees the old file or the whole new one. A
+    stream (a character device, a FIFO, a descriptor's name such as ``/dev/stdout``) gets
+    the finished bytes written through, and is never replaced nor truncated. A symbolic
+    link is refused, never followed; ``picked``: a name mjeap chose, a regular file or none
+    (:func:`output_kind`). The path's lock is held meanwhile (:func:`hold`); SIGINT and
+    SIGTERM are delivered after."""
+    kind = output_kind(path, name, picked)
     if kind == "stream":
-        with hold(path, name) as key, deferred_signals():
+        with hold(path, name) as key, deferred_signals(), _one_line(path):
             folder = Path(tempfile.mkdtemp(prefix="mjeap-"))
             try:
                 tmp = folder / f"out{Path(path).suffix}"
                 yield tmp
                 if tmp.exists():
+                    _flush_std()
                     _write_all(_held[key][2], tmp)
             finally:
                 shutil.rmtree(folder, ignore_errors=True)
         return
-    target = Path(os.path.realpath(path))
-    target.parent.mkdir(parents=True, exist_ok=True)
-    with hold(target, name) as key, deferred_signals():
+    target = _target(path)
+    with _one_line(path):
+        target.parent.mkdir(parents=True, exist_ok=True)
+    with hold(target, name, picked=picked) as key, deferred_signals(), _one_line(path):
         entry = _held[key]
         while True:
             tmp = target.with_name(f".{target.name}.{secrets.token_hex(8)}.tmp{target.suffix}")
@@ -326,17 +467,31 @@ def replacing(path, name: str = "path"):
             except OSError as e:
                 raise OutputError([(str(path), f"cannot create a temporary file beside it: {e.strerror or e}")]) \
                     from None
-        _write_lock(entry[2], entry[5], tmp.name)
         try:
+            _write_lock(entry[2], entry[5], tmp.name)
             yield tmp
-            if not tmp.exists():                      # the block wrote nothing: the path stays
+            if not os.path.lexists(tmp):              # the block wrote nothing: the path stays
                 return
             try:
-                mode = os.stat(target).st_mode & 0o7777
+                now = os.lstat(target)
+                mode = now.st_mode & 0o7777
+                if not stat.S_ISREG(now.st_mode):       # planted meanwhile: refused, never replaced
+                    kind = "symbolic link" if stat.S_ISLNK(now.st_mode) else _stat_kind(now.st_mode)
+                    raise OutputError([(str(path), f"it became a {kind} while mjeap wrote: refused, not replaced")])
             except FileNotFoundError:
                 mode = 0o666 & ~_umask()
-            os.chmod(tmp, mode)
-            _fsync(tmp)
+            try:
+                fd = os.open(tmp, os.O_RDONLY | os.O_NOFOLLOW | os.O_CLOEXEC)
+            except OSError as e:
+                raise OutputError([(str(path), f"its temporary file is gone or was replaced: {e.strerror or e}")]) \
+                    from None
+            try:
+                if not stat.S_ISREG(os.fstat(fd).st_mode):
+                    raise OutputError([(str(path), "its temporary file was replaced: not put in place")])
+                os.fchmod(fd, mode)
+                os.fsync(fd)
+            finally:
+                os.close(fd)
             os.replace(tmp, target)
             _fsync(target.parent)
         finally:
@@ -345,25 +500,32 @@ def replacing(path, name: str = "path"):
                     os.unlink(tmp)
             except OSError:
                 pass
-            _write_lock(entry[2], entry[5])
+            try:
+                _write_lock(entry[2], entry[5])
+            except OSError:
+                pass
 
 
 @contextmanager
-def run_guard(**paths):
+def run_guard(*, inputs: Optional[Mapping] = None, picked: Iterable[str] = (), **paths):
     """The block of a run that writes ``paths`` (name -> path or None): they are checked
-    (:func:`check_outputs`) and locked before it starts, and SIGTERM raises
+    (:func:`check_outputs`, against the run's ``inputs`` too; ``picked``: the names mjeap
+    chose) and locked before it starts, and SIGTERM raises
     :class:`~mjeap.errors.Terminated` (a KeyboardInterrupt) within it, as Ctrl-C does."""
+    picked = set(picked)
     with ExitStack() as stack:
-        out = check_outputs(**paths)
+        out = check_outputs(inputs=inputs, picked=picked, **paths)
         for name, p in out.items():
-            stack.enter_context(hold(p, name))
+            stack.enter_context(hold(p, name, picked=name in picked))
         stack.enter_context(sigterm_as_interrupt())
         yield out
 
 
-def guarded(*names: str):
+def guarded(*names: str, inputs: Optional[Callable[[dict], Mapping]] = None):
     """Decorator of a run (a stepping loop) whose arguments ``names`` are output paths: the
-    run is called within :func:`run_guard` of them, the one interrupt path of every run."""
+    run is called within :func:`run_guard` of them, the one interrupt path of every run.
+    ``inputs(arguments)`` (the bound arguments by name) gives the run's input files (name
+    -> path), which no output may be."""
     def wrap(fn):
         sig = inspect.signature(fn)
 
@@ -371,7 +533,8 @@ def guarded(*names: str):
         def run(*args, **kwargs):
             given = sig.bind(*args, **kwargs)
             given.apply_defaults()
-            with run_guard(**{n: given.arguments[n] for n in names}):
+            read = inputs(given.arguments) if inputs is not None else None
+            with run_guard(inputs=read, **{n: given.arguments[n] for n in names}):
                 return fn(*args, **kwargs)
         return run
     return wrap
@@ -385,22 +548,40 @@ def provenance() -> dict:
     return {"mujoco": mujoco.__version__, "mjeap": MJEAP_VERSION}
 
 
-def check_outputs(**paths) -> Dict[str, Path]:
+def check_inputs(outputs: Mapping, inputs: Optional[Mapping]) -> None:
+    """Refuse an output (name -> path) that is one of the run's ``inputs`` (name -> path or
+    None, or (name, path) pairs; the same resolved path or the same inode, :func:`same_file`), naming both, before
+    any work."""
+    pairs = inputs.items() if isinstance(inputs, Mapping) else (inputs or ())
+    for iname, ipath in pairs:
+        if ipath is None or (isinstance(ipath, str) and not ipath):
+            continue
+        for name, p in outputs.items():
+            if p is not None and same_file(p, ipath):
+                raise ParameterError(name, str(p), f"a path other than the {iname} {ipath}",
+                                     "it is one of the run's inputs: writing there would replace it")
+
+
+def check_outputs(*, inputs: Optional[Mapping] = None, picked: Iterable[str] = (), **paths) -> Dict[str, Path]:
     """The outputs a run will write (name -> path or None), checked before any work:
-    distinct, each a regular file (or none yet) in a folder that exists or can be made and
-    is writable, or a writable stream (:func:`output_kind`)."""
+    distinct, none one of the run's ``inputs`` (name -> path, :func:`check_inputs`), each a
+    regular file (or none yet; never a link) in a folder that exists or can be made and is
+    writable, or a writable stream (:func:`output_kind`; ``picked``: the names of paths
+    mjeap chose, a regular file or none)."""
     out, seen = {}, {}
+    picked = set(picked)
+    check_inputs(paths, inputs)
     for name, p in paths.items():
         if p is None:
             continue
         p = Path(p)
-        kind = output_kind(p, name)
+        kind = output_kind(p, name, name in picked)
         key = _key(p, kind)
         if key in seen:
             raise ParameterError(name, str(p), f"a file other than the {seen[key]} output's")
         seen[key] = name
         if kind == "stream":
-            if not os.access(p, os.W_OK):
+            if descriptor(p) is None and not os.access(p, os.W_OK):
                 raise ParameterError(name, str(p), "a writable path", f"cannot write {p}: permission denied")
             out[name] = p
             continue
@@ -410,10 +591,54 @@ def check_outputs(**paths) -> Dict[str, Path]:
         except OSError as e:
             raise ParameterError(name, str(p), "a path in a folder that exists or can be made",
                                  f"cannot write {p}: {e.strerror or e}") from None
+        if not parent.is_dir():
+            raise ParameterError(name, str(p), "a path in a folder", f"{parent} is not a folder")
         if not os.access(parent, os.W_OK | os.X_OK) or (kind == "file" and not os.access(key, os.W_OK)):
-            raise ParameterError(name, str(p), "a writable path", f"cannot write {p}: permission denied")
+            raise ParameterError(name, str(p), "a writable path", f"cannot write {p}: "
+                                 + ("read-only file system" if _read_only(parent) else "permission denied"))
         out[name] = p
     return out
+
+
+def _read_only(folder) -> bool:
+    try:
+        return bool(os.statvfs(folder).f_flag & os.ST_RDONLY)
+    except OSError:
+        return False
+
+
+def write_text(path, text: str, name: str = "path", picked: bool = False) -> Path:
+    """Write ``text`` (UTF-8) to ``path`` through :func:`replacing`: whole or not at all,
+    never through a link, a stream written through; the path returned."""
+    with replacing(path, name, picked) as tmp:
+        tmp.write_text(text, encoding="utf-8")
+    return Path(path)
+
+
+def appending(path, name: str = "path") -> int:
+    """A descriptor appending to output ``path`` (a sweep's CSV, one whole row at a time):
+    a regular file is opened without following a link (created if none), a stream is
+    written through (a descriptor's name: a duplicate of it, its offset shared). Refused
+    as :func:`output_kind` refuses."""
+    fd = descriptor(path)
+    if fd is not None:
+        output_kind(path, name)
+        return os.dup(fd)
+    kind = output_kind(path, name)
+    flags = os.O_WRONLY | os.O_CLOEXEC | os.O_NOFOLLOW | os.O_NOCTTY
+    if kind != "stream":
+        flags |= os.O_APPEND | os.O_CREAT
+    try:
+        fd = os.open(path, flags, 0o666)
+    except OSError as e:
+        if e.errno == errno.ELOOP:
+            output_kind(path, name)             # a link planted meanwhile: refused, naming it
+        raise _refused(name, path, "a path mjeap can write", f"cannot open {path}: {e.strerror or e}") from None
+    st = os.fstat(fd)
+    if kind != "stream" and not stat.S_ISREG(st.st_mode):
+        os.close(fd)
+        raise _refused(name, path, "a regular file", f"it is a {_stat_kind(st.st_mode)}: refused")
+    return fd
 
 
 def write_outputs(writers, error: Optional[BaseException], result=None) -> None:
@@ -426,8 +651,10 @@ def write_outputs(writers, error: Optional[BaseException], result=None) -> None:
         for path, write in writers:
             try:
                 write()
+            except OutputError as e:                 # one line each, as the writer said it
+                failures.extend(e.failures)
             except Exception as e:                   # noqa: BLE001 - reported, never masks the run's error
-                why = e.strerror if isinstance(e, OSError) and e.strerror and not isinstance(e, OutputError) else e
+                why = e.strerror if isinstance(e, OSError) and e.strerror else e
                 failures.append((path, f"{type(e).__name__}: {why}"))
     if not failures:
         return

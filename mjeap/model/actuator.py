@@ -4,6 +4,7 @@ Derived quantities (neutral axis, EI, mass per length) come from
 :func:`mjeap.model.section.multilayer_section` only."""
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass, field
 from typing import Dict, Optional, Tuple
 
@@ -12,7 +13,8 @@ import numpy as np
 from ..errors import ParameterError, check_positive
 from .section import SectionLayer, SectionProperties, multilayer_section
 
-__all__ = ["Layer", "Planform", "Sourced", "Actuator", "validate_actuator"]
+__all__ = ["Layer", "Planform", "Sourced", "Actuator", "validate_actuator", "check_geometry", "GeometryWarning",
+           "PLAUSIBLE", "MIN_SLENDERNESS"]
 
 #: 8-point Gauss-Legendre nodes and weights on [-1, 1] (the layered mass's quadrature)
 _GAUSS_8 = np.polynomial.legendre.leggauss(8)
@@ -165,8 +167,78 @@ class Actuator:
         return self.total_mass() + self.planform.tip_block_mass
 
 
-def validate_actuator(act: Actuator) -> Actuator:
-    """Raise ParameterError naming the first non-positive size or property of ``act``."""
+class GeometryWarning(UserWarning):
+    """A size of an actuator lies outside the range mjeap's actuators plausibly have (its
+    key named): a unit slip (a bare 60 is 60 m) or a design beyond the beam model."""
+
+
+#: plausible sizes (SI, m) of the actuators mjeap models: outside them a GeometryWarning
+PLAUSIBLE = {"length": (10e-6, 1.0), "width": (1e-6, 1.0), "thickness": (10e-9, 5e-3)}
+#: the slenderness (length / total thickness) below which a GeometryWarning says the beam model
+#: strains: under a tip force shear adds E h^2 / (4 kappa G L^2) ~ 0.8 (h/L)^2 to Euler-Bernoulli's
+#: deflection (rectangle, kappa = 5/6, E/G = 2.6): 3 % at L/h = 5
+MIN_SLENDERNESS = 5.0
+
+
+#: the actuators whose implausible sizes were told (by id; the entry goes with the actuator)
+_WARNED: "weakref.WeakValueDictionary" = weakref.WeakValueDictionary()
+
+
+def check_geometry(act: "Actuator", where: Optional[str] = None) -> None:
+    """The sizes of ``act`` against each other and against physics (``where``: the prefix
+    of the keys named, e.g. the file): a ParameterError where the shape is no beam at all
+    (a layer as thick as the beam is long or as it is wide, the stack as thick as the beam
+    is long); a :class:`GeometryWarning` naming the key outside a plausible range
+    (:data:`PLAUSIBLE`, :data:`MIN_SLENDERNESS`; a beam thicker than wide)."""
+    import warnings
+    p = act.planform
+    pre = f"{act.id}." if where is None else where
+    total = sum(l.thickness for l in act.layers)
+    narrow = min(p.base_width, p.tip_width)
+    for l in act.layers:
+        key = f"{pre}layers.{l.name}.thickness"
+        width = l.width if l.width is not None else narrow
+        if l.thickness >= p.length:
+            raise ParameterError(key, l.thickness, f"a thickness (m) below the beam's length {p.length:.4g} m",
+                                 "a layer as thick as the beam is long is no beam; a bare number is SI (60 is 60 m, "
+                                 "'60 um' is 60 um)")
+        if l.thickness >= width:
+            raise ParameterError(key, l.thickness, f"a thickness (m) below the layer's width {width:.4g} m",
+                                 "a layer thicker than it is wide is no bending strip; a bare number is SI")
+    if total >= p.length:
+        raise ParameterError(f"{pre}layers (total thickness)", total, f"a stack thinner than the beam's length "
+                             f"{p.length:.4g} m", "a bare number is SI")
+
+    if _WARNED.get(id(act)) is act:          # told once per actuator (a file read, then its Scene built)
+        return
+    _WARNED[id(act)] = act
+
+    def warn(key, value, text):
+        warnings.warn(f"{key} = {value:.4g} m {text}", GeometryWarning, stacklevel=4)
+
+    for key, value, kind in ([(f"{pre}planform.length", p.length, "length"),
+                              (f"{pre}planform.base_width", p.base_width, "width"),
+                              (f"{pre}planform.tip_width", p.tip_width, "width")]
+                             + [(f"{pre}layers.{l.name}.thickness", l.thickness, "thickness") for l in act.layers]
+                             + [(f"{pre}layers.{l.name}.width", l.width, "width") for l in act.layers
+                                if l.width is not None]):
+        lo, hi = PLAUSIBLE[kind]
+        if not lo <= value <= hi:
+            warn(key, value, f"lies outside the plausible {kind} of a bending actuator, [{lo:g}, {hi:g}] m: "
+                             "a unit slip? (a bare number is SI)")
+    if p.length / total < MIN_SLENDERNESS:
+        warn(f"{pre}planform.length", p.length, f"is {p.length / total:.3g} x the stack's thickness ({total:.4g} m): "
+             f"below {MIN_SLENDERNESS:g} a thick beam, whose shear deformation (~0.8 (h/L)^2 of the deflection "
+             "under a tip force) the Euler-Bernoulli model leaves out")
+    if narrow < total:
+        warn(f"{pre}planform.{'tip_width' if p.tip_width < p.base_width else 'base_width'}", narrow,
+             f"is narrower than the stack is thick ({total:.4g} m): the strip bends more easily sideways, out "
+             "of the plane mjeap models")
+
+
+def validate_actuator(act: Actuator, where: Optional[str] = None) -> Actuator:
+    """Raise ParameterError naming the first non-positive size or property of ``act``, or a
+    shape that is no beam (:func:`check_geometry`, which warns of implausible sizes)."""
     check_positive(f"{act.id}.planform.length", act.planform.length, "m")
     check_positive(f"{act.id}.planform.base_width", act.planform.base_width, "m")
     check_positive(f"{act.id}.planform.tip_width", act.planform.tip_width, "m")
@@ -181,4 +253,5 @@ def validate_actuator(act: Actuator) -> Actuator:
     for o in ("flexural_rigidity", "mass"):
         if getattr(act, o) is not None:
             check_positive(f"{act.id}.{o}", getattr(act, o).value, getattr(act, o).unit)
+    check_geometry(act, where)
     return act

@@ -7,7 +7,8 @@ A bare number is SI; a string carries its unit (``"10 mm"``, ``"40 GPa"``,
     id = "long-bimorph"                  # letters, digits, '-', '_'
     title = "A longer tapered PZT-5H bimorph"
     [document]                           # the source the actuator comes from (text)
-    drive = "piezo-bimorph"              # a registered drive (mjeap.drives), or "none"
+    drive = "piezo-bimorph"              # a registered drive (mjeap.drives), or "none"; with
+                                         # [drive.parameters]: drive.name = "piezo-bimorph" (TOML)
     damping_ratio = 0.05                 # first-mode modal damping ratio, (0, 1)
     voltage_range = ["0 V", "200 V"]     # safe drive voltage, low < high
     [plane_strain = false]               # default: the width >= 5 thickness rule
@@ -29,7 +30,9 @@ A bare number is SI; a string carries its unit (``"10 mm"``, ``"40 GPa"``,
     [drive.sources]
     bias = "..."
 
-Everything is checked on load, before any work: an error names the file, the key and what is
+The file is read by :mod:`tomllib` alone (strict TOML: ``drive = "NAME"`` and a
+``[drive.parameters]`` table cannot both stand; ``drive.name = "NAME"`` can). Everything is
+checked on load, before any work: an error names the file, the key and what is
 accepted (a missing layer, a negative thickness, an unknown material or drive, a drive whose
 layer roles are missing, a unit that does not parse); a layer value outside its material's
 range is a :class:`~mjeap.model.materials.RangeWarning`, 1000 x outside it an error.
@@ -153,10 +156,7 @@ def read_actuator(path):
     if not path.is_file():
         raise ParameterError("actuator", str(path), "an existing actuator file (.toml)",
                              "no such file" if not path.exists() else "not a regular file")
-    try:
-        doc = tomllib.loads(_drive_shorthand(path.read_text(encoding="utf-8")))
-    except (tomllib.TOMLDecodeError, UnicodeDecodeError) as e:
-        raise ParameterError("actuator", str(path), "a TOML file", f"it does not parse: {e}") from None
+    doc = _parse(path)
     r.unknown(doc, (*TOP_KEYS, "drive"), "")
     drive_table = doc.get("drive") if isinstance(doc.get("drive"), dict) else None
     aid = r.text(doc, "id", required=True)
@@ -184,7 +184,7 @@ def read_actuator(path):
     num = lambda k, **kw: r.number(pf, k, _UNITS[k], "planform.", **kw)  # noqa: E731
     length, base = num("length", required=True), num("base_width", required=True)
     planform = Planform(length=length, base_width=base, tip_width=num("tip_width", default=base),
-                        source=r.text(pf, "source", "planform.", default="not given"),
+                        source=r.text(pf, "source", "planform.", default="given in the file"),
                         extension_length=num("extension_length", positive=False, default=0.0),
                         extension_mass=num("extension_mass", positive=False, default=0.0),
                         extension_source=r.text(pf, "extension_source", "planform.", default="none"),
@@ -240,7 +240,7 @@ def read_actuator(path):
         layers.append(Layer(name=name, material=r.text(ld, "description", pre, default=m.title if m else name),
                             thickness=r.number(ld, "thickness", "m", pre, required=True),
                             width=r.number(ld, "width", "m", pre, default=None), source=r.text(
-                                ld, "source", pre, default=(f"material {m.name}" if m else "not given")),
+                                ld, "source", pre, default="given in the file"),
                             sources=dict(sources), role=r.text(ld, "role", pre, default=""),
                             material_key=m.name if m else None, **values, **piezo))
     # overrides
@@ -285,9 +285,10 @@ def read_actuator(path):
         raise r.error(f"sources.{sorted(bad)[0]}", src[sorted(bad)[0]],
                       "a source for damping_ratio, voltage_range, plane_strain, flexural_rigidity or mass")
     try:
-        validate_actuator(act)
+        validate_actuator(act, where=r.where(""))
     except ParameterError as e:
-        raise ParameterError(r.where(e.name), e.value, e.accepted, e.why) from None
+        raise ParameterError(e.name if e.name.startswith(r.where("")) else r.where(e.name), e.value, e.accepted,
+                             e.why) from None
     why = None if _drive_info is None else _drive_info.stack_reason(drive, act)
     if why is not None:
         raise r.error("layers", [f"{l.name} ({l.role or 'no role'})" for l in act.layers],
@@ -340,17 +341,35 @@ def _unknown(where: str, kind: str, name: str, known) -> UnknownNameError:
     return e
 
 
-_DRIVE_LINE = re.compile(r'^(\s*)drive(\s*=\s*["\'])', re.MULTILINE)
-_DRIVE_TABLE = re.compile(r"^\s*\[\s*drive\s*\.", re.MULTILINE)
+#: the largest actuator file read (bytes): a description, not a data set
+MAX_FILE_BYTES = 1 << 20
 
 
-def _drive_shorthand(text: str) -> str:
-    """``drive = "NAME"`` beside ``[drive.parameters]`` (the form people write, which strict
-    TOML forbids: ``drive`` cannot be text and a table) read as ``drive.name = "NAME"``."""
-    head = text.split("[", 1)[0] if not text.lstrip().startswith("[") else ""
-    if _DRIVE_TABLE.search(text) and _DRIVE_LINE.search(head):
-        return _DRIVE_LINE.sub(r"\1drive.name\2", text, count=1)
-    return text
+def _parse(path: Path) -> dict:
+    """The file's TOML document, read by :mod:`tomllib` alone; what it cannot read (not
+    TOML, not UTF-8, nested too deep, a number too long, too large a file) is one
+    ParameterError naming the file."""
+    def refuse(why):
+        return ParameterError("actuator", str(path), "a TOML actuator file (docs/actuators/files.md)", why)
+    try:
+        with open(path, "rb") as fh:
+            data = fh.read(MAX_FILE_BYTES + 1)
+    except OSError as e:
+        raise refuse(f"cannot read it: {e.strerror or e}") from None
+    if len(data) > MAX_FILE_BYTES:
+        raise refuse(f"it is larger than {MAX_FILE_BYTES // 1024} KiB: an actuator file describes one actuator")
+    try:
+        return tomllib.loads(data.decode("utf-8"))
+    except UnicodeDecodeError as e:
+        raise refuse(f"it is not UTF-8 text ({e.reason} at byte {e.start})") from None
+    except tomllib.TOMLDecodeError as e:
+        hint = ("; a drive with parameters is a table: write drive.name = \"NAME\" (or name = \"NAME\" under "
+                "[drive]) instead of drive = \"NAME\" beside [drive.parameters]") if "overwrite" in str(e) else ""
+        raise refuse(f"it does not parse: {e}{hint}") from None
+    except RecursionError:
+        raise refuse("its arrays or tables are nested too deep to read") from None
+    except (ValueError, OverflowError, MemoryError) as e:     # an integer of thousands of digits
+        raise refuse(f"it does not parse: {e}") from None
 
 
 def _drive_parameters(r: _Reader, drive: str, table) -> Dict[str, tuple]:

@@ -9,6 +9,7 @@ from __future__ import annotations
 import dataclasses
 import hashlib
 import os
+import warnings
 from pathlib import Path
 from typing import Dict
 
@@ -84,8 +85,8 @@ _FILES = BoundedCache("actuator files", max_entries=64, locked=True)
 
 def file_actuator(path) -> Actuator:
     """The Actuator of the actuator file ``path`` (:func:`read_actuator`), one object per
-    file content: read again, an unchanged file gives the object it gave before; a changed
-    one is read anew."""
+    file content: read again, an unchanged file gives the object it gave before (and the
+    warnings its reading gave, again); a changed one is read anew."""
     p = Path(path)
     try:
         data = p.read_bytes() if p.is_file() else None
@@ -94,7 +95,16 @@ def file_actuator(path) -> Actuator:
     if data is None:                    # read_actuator says what is wrong with it
         return read_actuator(path)
     key = (str(path), os.path.realpath(p), hashlib.blake2b(data, digest_size=16).digest())
-    return _FILES.get_or_build(key, lambda: read_actuator(path))
+
+    def read():
+        with warnings.catch_warnings(record=True) as told:
+            warnings.simplefilter("always")
+            act = read_actuator(path)
+        return act, [(w.message, w.category) for w in told]
+    act, told = _FILES.get_or_build(key, read)
+    for message, category in told:      # what reading the file warns, every time it is read
+        warnings.warn(message, category, stacklevel=3)
+    return act
 
 
 def check_actuator_files(names) -> None:

@@ -33,7 +33,11 @@ class Payload:
     beam (Dadras et al. 2021's effective length l_e; it may sit on a rigid tip extension and overhang
     the tip by up to 25 % of L, a magnet stuck on the tip). Its rotary inertia about its
     centre (kg m^2): ``inertia`` if given (0 is a point mass, :meth:`point`), else that of a
-    solid sphere of ``radius`` (m), by default an NdFeB sphere of the same mass."""
+    solid sphere of ``radius`` (m), by default an NdFeB sphere of the same mass.
+
+    Gravity loads the payload in the bending plane only under the orientations ``up`` and
+    ``down``: the default ``horizontal`` lays the bending plane horizontal (gravity across
+    the width), so there a payload adds inertia, not a static bend (:func:`clamp_rotation`)."""
 
     mass: float
     position: float

@@ -104,7 +104,11 @@ def to_si(value, unit: str, where: str) -> float:
     if isinstance(value, bool):
         raise ParameterError(where, value, f"a number in {unit} (SI) or a string with a unit, e.g. '1.5 {unit}'")
     if isinstance(value, (int, float)):
-        v = float(value)
+        try:
+            v = float(value)
+        except OverflowError:                      # an integer of hundreds of digits
+            raise ParameterError(where, f"an integer of {len(str(abs(value)))} digits",
+                                 f"a finite quantity in {unit}") from None
     elif isinstance(value, str):
         m = _NUMBER.match(value)
         if m is None:
@@ -119,7 +123,10 @@ def to_si(value, unit: str, where: str) -> float:
             f, d = 1.0, want                                  # a bare number in a string: SI
         if d != want:
             raise ParameterError(where, value, f"a quantity in {unit}", f"'{m.group(2)}' is another dimension")
-        v = float(m.group(1)) * f
+        try:
+            v = float(m.group(1)) * f
+        except OverflowError:  # pragma: no cover - float() of text gives inf, not this
+            v = math.inf
     else:
         raise ParameterError(where, value, f"a number in {unit} (SI) or a string with a unit")
     if not math.isfinite(v):

@@ -22,7 +22,7 @@ from ..engines.frame import (DEFAULT_SAMPLES, MAX_INITIAL_BEND, MAX_STEPS, check
 from ..engines.result import RolloutResult
 from ..errors import ParameterError, check_integer, check_positive
 from ..io.outputs import check_outputs, guarded, write_outputs
-from .scene import Scene
+from .scene import Scene, as_scene, input_files
 from ..drives.waveforms import Waveform
 
 __all__ = ["rollout", "rollout_batch", "free_vibration", "RolloutResult", "ENGINES", "MAX_STEPS", "DEFAULT_SAMPLES",
@@ -39,16 +39,23 @@ def check_stop(stop_when_periodic, wave, duration: float, sample_interval: Optio
                                duration / (GRID_SAMPLES if at_accuracy else DEFAULT_SAMPLES))
 
 
-@guarded("rrd", "csv_path")
-def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: float, *,
+def _inputs(args: dict) -> list:
+    """A rollout's input files (its actuator file, its waveform's CSV): no output may be one."""
+    v = args.get("voltage")
+    return input_files([args["scene"]], v if isinstance(v, (list, tuple)) else [v])
+
+
+@guarded("rrd", "csv_path", inputs=_inputs)
+def rollout(scene: Union[Scene, str, Path], voltage: Union[str, Waveform, callable], duration: float, *,
             drive: Union[str, "object", None] = None, drive_params: Optional[dict] = None,
             initial_curvature: float = 0.0, rrd: Union[str, Path, None] = None,
             csv_path: Union[str, Path, None] = None, sample_interval: Optional[float] = None,
-            progress: Optional[bool] = None, check_every: int = 100, controller=None,
+            progress: Union[bool, str, None] = None, check_every: int = 100, controller=None,
             engine: str = "auto", max_steps: Optional[int] = None, accuracy: Optional[float] = None,
             estimate_error: bool = False, error_model=None,
             stop_when_periodic: Optional[float] = None, metrics: Optional[Sequence[str]] = None) -> RolloutResult:
-    """Run ``scene`` driven by ``drive`` (name, instance or None for the actuator's own)
+    """Run ``scene`` (a Scene, or a catalog id or actuator file's path: its default Scene,
+    :func:`mjeap.simulation.scene.as_scene`) driven by ``drive`` (name, instance or None for the actuator's own)
     with ``voltage`` (waveform text, :class:`Waveform` or callable v(t)) for ``duration`` s,
     or closed loop under ``controller`` (``voltage`` then None): a callable
     ``controller(t, scene) -> V``, a plain function or an object, with optional ``reset``,
@@ -78,6 +85,9 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     to its own scale, not to the trajectory; slow questions then take steps far beyond the
     modes' resolution (:mod:`mjeap.simulation.metric_accuracy`).
 
+    ``progress``: None (default: a bar on a terminal once the run has lasted 2 s), True, False
+    or ``"lines"`` (one line per 10 % of the simulated time, for logs; :mod:`mjeap.engines.progress`).
+
     ``stop_when_periodic`` (relative tolerance, periodic waveforms): the run stops at the
     first period boundary, from the third, where its last period repeats the one before
     within the tolerance and the shrinking change still to come stays within it (tip
@@ -86,6 +96,7 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
     """
     from ..drives import make_drive
 
+    scene = as_scene(scene)
     duration = check_positive("duration", duration, "s")
     ctrl_name = None if controller is None else check_controller(controller, voltage)
     initial_curvature = check_initial_curvature(initial_curvature, scene.layout.length)
@@ -112,14 +123,15 @@ def rollout(scene: Scene, voltage: Union[str, Waveform, callable], duration: flo
         csv_path=csv_path))
 
 
-def free_vibration(scene: Scene, curvature: float, duration: float, **kw) -> RolloutResult:
+def free_vibration(scene: Union[Scene, str, Path], curvature: float, duration: float, **kw) -> RolloutResult:
     """Release the beam, bent to a uniform arc of ``curvature`` (1/m), with no drive holding
     it, and follow it for ``duration`` s: a free vibration under its elasticity, damping,
     gravity and loads (the ``none`` drive). Keywords as :func:`rollout`."""
     return rollout(scene, "step:0V", duration, drive="none", initial_curvature=curvature, **kw)
 
 
-def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable]], duration: float, *,
+def rollout_batch(scene: Union[Scene, str, Path], voltages: Sequence[Union[str, Waveform, callable]], duration: float,
+                  *,
                   drive: Optional[str] = None, drive_params: Optional[dict] = None,
                   initial_curvatures: Union[float, Sequence[float]] = 0.0,
                   sample_interval: Optional[float] = None, nthread: Optional[int] = None,
@@ -138,6 +150,7 @@ def rollout_batch(scene: Scene, voltages: Sequence[Union[str, Waveform, callable
     error. ``metrics`` (with a target): the target is on these metrics of each member, each
     member choosing its own model as :func:`rollout` does (one by one)."""
     from ..drives import make_drive
+    scene = as_scene(scene)
     duration = check_positive("duration", duration, "s")
     if np.ndim(initial_curvatures) == 0:
         kappa0 = None

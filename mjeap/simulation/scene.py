@@ -593,3 +593,37 @@ class Scene:
                 "segments": self.layout.segments, "orientation": self.orientation,
                 "payload_kg": None if self.payload is None else self.payload.mass,
                 "units": self.units.describe(), **c.as_dict()}
+
+
+def as_scene(scene, name: str = "scene") -> Scene:
+    """A Scene from what stands where one is expected: a Scene as it is; a catalog id, an
+    actuator file's path or an :class:`~mjeap.model.catalog.Actuator`, its default Scene
+    (``Scene(name)``); anything else refused naming ``name``."""
+    from pathlib import Path
+    if isinstance(scene, Scene):
+        return scene
+    if isinstance(scene, (str, Path, Actuator)):
+        return Scene(scene)
+    raise ParameterError(name, type(scene).__name__, "a Scene, a catalog id ('pedot-micro'), an actuator file's path "
+                         "(.toml) or an Actuator")
+
+
+def input_files(actuators=(), voltages=()) -> list:
+    """The files a run reads, as (name, path) pairs (:func:`mjeap.io.outputs.check_inputs`:
+    none may be an output of the run): the actuator files of ``actuators`` (Scenes,
+    Actuators, catalog ids or paths) and the CSVs of ``voltages`` (``csv:PATH`` texts or
+    Waveforms)."""
+    from pathlib import Path
+    from ..model.actuator_file import is_actuator_file
+    out = []
+    for a in actuators:
+        a = getattr(a, "actuator", a)
+        f = getattr(a, "source_file", None) if isinstance(a, Actuator) else (
+            a if isinstance(a, (str, Path)) and is_actuator_file(a) else None)
+        if f:
+            out.append(("actuator file", str(f)))
+    for v in voltages:
+        text = v if isinstance(v, str) else getattr(v, "text", None)
+        if isinstance(text, str) and text.strip().lower().startswith("csv:"):
+            out.append(("voltage CSV", text.strip()[4:].strip()))
+    return out

@@ -36,7 +36,7 @@ from ..engines.frame import check_work, one_voltage
 from ..engines.result import SystemResult
 from ..engines.native import why_not as native_why_not
 from ..model.fields import UNITS_FIELD, add_units, apply_dof_damping
-from .scene import DEFAULT_SEGMENTS, INTEGRATORS, Scene, diverged
+from .scene import DEFAULT_SEGMENTS, INTEGRATORS, Scene, diverged, input_files
 from ..units import DEFAULT_UNITS, UnitSystem
 
 _PREFIX = re.compile(r"^[A-Za-z][A-Za-z0-9_-]*$")
@@ -621,7 +621,10 @@ class System:
             vs[k] = v
 
     # ------------------------------------------------------------------ rollout
-    @guarded("rrd")
+    @guarded("rrd", inputs=lambda a: input_files(
+        [x.twin for x in a["self"].actuators],
+        list(a["voltages"].values()) if isinstance(a["voltages"], dict) else
+        (a["voltages"] if isinstance(a["voltages"], (list, tuple)) else [a["voltages"]])))
     def rollout(self, voltages, duration: float, *, initial_curvatures: Union[float, Sequence[float]] = 0.0,
                 sample_interval: Optional[float] = None, rrd: Union[str, Path, None] = None,
                 on_sample=None, controller=None, engine: str = "auto", estimate_error: bool = False) -> SystemResult:

@@ -70,6 +70,9 @@ VARIABLE = {"payload_mass": ("kg", 0.0, math.inf, False), "payload_position": ("
 #: the files an optimisation writes in its folder
 RESULT, EVALUATIONS, OPTIMUM = "result.json", "evaluations.csv", "optimum.toml"
 FIGURE, PARETO, PARETO_FIGURE = "optimize.png", "pareto.csv", "pareto.png"
+#: the actuator file of an optimisation that found no feasible point: its least infeasible point,
+#: never named optimum; BASE: an Actuator object given as the base, written for the evaluations
+LEAST_INFEASIBLE, BASE = "least-infeasible.toml", "base.toml"
 _CONSTRAINT = re.compile(r"^\s*([A-Za-z0-9_-]+)\s*(>=|<=)\s*(.+?)\s*$")
 
 
@@ -181,7 +184,7 @@ class OptimizeResult:
     method: str
     wall_s: float
     runs: List[dict] = field(default_factory=list)
-    actuator: object = None                 # the optimum's Actuator
+    actuator: object = None                 # the optimum's Actuator (the least infeasible point's: feasible False)
     files: Dict[str, str] = field(default_factory=dict)
     #: the objective's sensitivity to each active bound and constraint (module text)
     sensitivities: List[dict] = field(default_factory=list)
@@ -191,6 +194,7 @@ class OptimizeResult:
     evaluated: List[tuple] = field(default_factory=list, repr=False)
     #: each variable swept through the optimum, the others held: name -> evaluations as above
     slices: Dict[str, List[tuple]] = field(default_factory=dict, repr=False)
+    feasible: bool = True                   # False: no point met the constraints (the least infeasible is reported)
 
     def as_dict(self) -> dict:
         d = {k: getattr(self, k) for k in ("optimum", "metrics", "objective", "constraints", "sensitivities",
@@ -401,13 +405,19 @@ def _base_actuator(actuator, folder: Optional[Path]):
     if isinstance(actuator, Path):
         return str(actuator), None
     if isinstance(actuator, Actuator):
-        from ..model.actuator_file import write_actuator
+        from ..model.actuator_file import actuator_toml, write_actuator
         tmp = None
         if folder is None:
             tmp = tempfile.TemporaryDirectory(prefix="mjeap-optimize-")
             folder = Path(tmp.name)
-        path = folder / "base.toml"
-        write_actuator(actuator, path)
+        path = folder / BASE
+        text = actuator_toml(actuator)
+        if path.is_file() and path.read_text(encoding="utf-8", errors="replace") != text:
+            raise ParameterError("--out", str(folder), f"a folder whose {BASE} is this base actuator, or none",
+                                 f"{path} exists and holds another file: refused, not replaced; choose another "
+                                 "folder or remove it")
+        if not path.is_file():
+            write_actuator(actuator, path)
         return str(path), tmp
     if not isinstance(actuator, str):
         raise ParameterError("actuator", actuator, "a catalog id, an actuator file's path or an Actuator")
@@ -465,6 +475,7 @@ def optimize(actuator, vary: Mapping[str, object], maximize: Optional[str] = Non
     held (the figure's lines; 0: none), within the budget and written as the others are."""
     from ..model import variants
     from ..io.outputs import check_outputs, hold, replacing
+    from ..model.actuator_file import actuator_toml, is_actuator_file
     from .sweep import METRICS, STATIC_METRICS, check_metric_settings, check_settings
     from .sweep.points import _check_names
     from .sweep.runner import _drop_torn_row, _read_sweep_csv, _RowFile
@@ -515,10 +526,15 @@ def optimize(actuator, vary: Mapping[str, object], maximize: Optional[str] = Non
             raise ParameterError("--out", str(folder), "a folder for result.json, evaluations.csv and optimum.toml",
                                  "it is a file")
         files = {k: folder / v for k, v in (("result", RESULT), ("evaluations", EVALUATIONS), ("optimum", OPTIMUM),
-                                            ("figure", FIGURE))}
+                                            ("figure", FIGURE), ("least_infeasible", LEAST_INFEASIBLE))}
         if front is not None:
             files.update(pareto=folder / PARETO, pareto_figure=folder / PARETO_FIGURE)
-        check_outputs(**{f"--out ({p.name})": p for p in files.values()})
+        named = {f"--out ({p.name})": p for p in files.values()}
+        if not isinstance(actuator, (str, Path)):
+            named[f"--out ({BASE})"] = folder / BASE
+        # names mjeap picks: regular files or none, never a link, never the base actuator's file
+        check_outputs(inputs=[("base actuator file", actuator if isinstance(actuator, (str, Path)) and
+                               is_actuator_file(actuator) else None)], picked=named, **named)
     base_name, tmp = _base_actuator(actuator, folder)
     try:
         fixed = dict(base or {})
@@ -558,7 +574,7 @@ def optimize(actuator, vary: Mapping[str, object], maximize: Optional[str] = Non
                             sign, constraints, feasibility, method, starts, seed, tol, fd_step, maxiter, popsize,
                             active, base_name, t0, files, act0, de_tol, front, pareto_points, slice_points)
             csv_path = files["evaluations"]
-            with hold(csv_path, "--out (evaluations.csv)", holder="mjeap optimize"):
+            with hold(csv_path, "--out (evaluations.csv)", holder="mjeap optimize", picked=True):
                 _drop_torn_row(csv_path)
                 cached, delimiter = {}, ","
                 if csv_path.exists() and csv_path.stat().st_size > 0:
@@ -567,7 +583,7 @@ def optimize(actuator, vary: Mapping[str, object], maximize: Optional[str] = Non
                         raise ParameterError("--out", str(csv_path), f"the evaluations of this optimisation (columns "
                                              f"{columns}); it has {header}: choose another --out")
                     cached = {r["point_id"]: r for r in rows}
-                writer = _RowFile(csv_path, delimiter)
+                writer = _RowFile(csv_path, delimiter, "--out (evaluations.csv)")
                 try:
                     if not cached:
                         writer.write(columns, 0)
@@ -576,8 +592,13 @@ def optimize(actuator, vary: Mapping[str, object], maximize: Optional[str] = Non
                                   maxiter, popsize, active, base_name, t0, files, act0, de_tol, front, pareto_points, slice_points)
                 finally:
                     writer.close()
+            # the point's actuator file: named optimum only where the point is feasible
+            which = "optimum" if result.feasible else "least_infeasible"
+            result.files = {k: v for k, v in result.files.items()
+                            if k not in ("optimum", "least_infeasible") or (k == which and result.actuator is not None)}
             if result.actuator is not None:
-                result.actuator.to_file(files["optimum"])
+                with replacing(files[which], f"--out ({files[which].name})", picked=True) as t:
+                    Path(t).write_text(actuator_toml(result.actuator), encoding="utf-8")
             if front is not None:
                 _write_front(files["pareto"], result.pareto, front, names, base_name)
             drawn = _draw(result, files, names, lo, hi, constraints, front, base_name)
@@ -586,7 +607,7 @@ def optimize(actuator, vary: Mapping[str, object], maximize: Optional[str] = Non
                 for k in ("figure", "pareto_figure"):
                     result.files.pop(k, None)
             text = json.dumps(result.as_dict(), indent=2, default=float)
-            with replacing(files["result"], "--out (result.json)") as t:
+            with replacing(files["result"], "--out (result.json)", picked=True) as t:
                 Path(t).write_text(text + "\n", encoding="utf-8")
             return result
     finally:
@@ -695,7 +716,9 @@ def _run(names, lo, hi, wanted, fixed, cached, writer, columns, max_evaluations,
                 **act.drive_parameters, **{k: (float(v), "", "set by mjeap optimize") for k, v in drive_set.items()}})
         sense = "maximise" if sign > 0 else "minimise"
         act = dataclasses.replace(
-            act, id=f"{act0.id}-optimum", title=f"{act0.title}, optimised ({sense} {objective})",
+            act, id=f"{act0.id}-optimum" if feasible else f"{act0.id}-least-infeasible",
+            title=f"{act0.title}, optimised ({sense} {objective})" if feasible else
+            f"{act0.title}, least infeasible point ({sense} {objective}: no point met the constraints)",
             notes=(act0.notes + "\n" if act0.notes else "") + f"mjeap optimize: {sense} {objective}"
             + (f" subject to {', '.join(c.expression for c in constraints)}" if constraints else "")
             + f" over {', '.join(f'{n} in [{a:g}, {b:g}]' for n, a, b in zip(names, lo, hi))}; optimum "
@@ -713,7 +736,7 @@ def _run(names, lo, hi, wanted, fixed, cached, writer, columns, max_evaluations,
                                                        "infeasible is reported"),
         method=method, wall_s=time.perf_counter() - t0, runs=runs, actuator=act,
         files={k: str(v) for k, v in files.items()}, sensitivities=sensitivities, pareto=front, evaluated=evaluated,
-        slices=slices)
+        slices=slices, feasible=feasible)
 
 
 def _slices(ev: _Evaluations, u: np.ndarray, points: int) -> Dict[str, List[tuple]]:

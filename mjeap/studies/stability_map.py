@@ -20,7 +20,7 @@ from typing import Dict, Sequence
 import numpy as np
 
 from ..io.commandline import arg_integer, arg_output, parse_args
-from ..io.outputs import replacing
+from ..io.outputs import check_outputs, replacing
 from ..io.recording import rrd_file
 from ..model import analytical as an
 from ..engines import ENGINES
@@ -90,6 +90,9 @@ def main(argv=None):
         from ..simulation.accuracy import check_accuracy
         check_accuracy(a.accuracy)
     out = Path(a.out)
+    # the files it names itself, checked before any work: regular files or none, never a link
+    named = {f"--out ({n})": out / n for n in ("stability_map.png", "report.md", "stability_map.rrd")}
+    check_outputs(picked=named, **named)
     masses = np.linspace(0.0, 150e-6, a.masses)[1:]
     amps = np.linspace(0.25, 1.5, a.amplitudes)
     points = grid(payload_mass=[float(m) for m in masses], amplitude=[float(v) for v in amps])
@@ -134,12 +137,12 @@ def main(argv=None):
         ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2)
         ax.set_title("pedot-micro standing up, l_e = 6.27 mm, 0.1 Hz")
         fig.tight_layout()
-        with replacing(out / "stability_map.png", "--out") as tmp:
+        with replacing(out / "stability_map.png", "--out (stability_map.png)", picked=True) as tmp:
             fig.savefig(tmp, dpi=120, format="png")
         lines.insert(2, "![stability map](stability_map.png)\n")
     except ImportError:
         lines.append("\n(figure skipped: pip install -e '.[report]' for matplotlib)")
-    with replacing(out / "report.md", "--out") as tmp:
+    with replacing(out / "report.md", "--out (report.md)", picked=True) as tmp:
         tmp.write_text("\n".join(lines) + "\n")
 
     # the recording: the report beside the map as a figure (axes, units, legend); without
@@ -153,7 +156,8 @@ def main(argv=None):
     rec = rr.RecordingStream("mjeap stability map")
     bp = rrb.Blueprint(rrb.Horizontal(*views, column_shares=[2, 3][:len(views)]), rrb.BlueprintPanel(state="collapsed"),
                        rrb.SelectionPanel(state="collapsed"), rrb.TimePanel(state="collapsed"))
-    with replacing(out / "stability_map.rrd", "--out") as tmp, rrd_file(rec, tmp, bp):
+    with replacing(out / "stability_map.rrd", "--out (stability_map.rrd)", picked=True) as tmp, \
+            rrd_file(rec, tmp, bp):
         if figure.exists():
             rec.log("figure", rr.EncodedImage(path=figure), static=True)
         table = ["", "| payload (mg) | amplitude (V) | returns |", "|---|---|---|"]

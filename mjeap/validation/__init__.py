@@ -47,13 +47,18 @@ def run_validation(names: Optional[Iterable[str]] = None, out: Optional[Path] = 
         bar = names
     done: List[Experiment] = []
     guard = ExitStack()
+    figures = report.have_matplotlib()
     if out is not None:
         out = Path(out)
-        out.mkdir(parents=True, exist_ok=True)
-        # the summaries locked before any work; until the last experiment has run they say
-        # which have not (an interrupted run's report is marked incomplete, never passed)
-        guard.enter_context(run_guard(json=out / "validation.json", report=out / "report.md"))
-    figures = report.have_matplotlib()
+        # every file it will write, named by mjeap itself, checked and locked before any work
+        # (regular files or none, never a link); until the last experiment has run the summaries
+        # say which have not (an interrupted run's report is marked incomplete, never passed)
+        files = {"--out (validation.json)": out / "validation.json", "--out (report.md)": out / "report.md"}
+        for name in names:
+            files[f"--out ({name}.rrd)"] = out / f"{name}.rrd"
+            if figures:
+                files[f"--out ({name}.png)"] = out / f"{name}.png"
+        guard.enter_context(run_guard(picked=files, **files))
     with guard:
         if out is not None:
             report.write_json(done, out / "validation.json", pending=names)

@@ -53,11 +53,11 @@ def header(actuator_id: str) -> str:
 
 
 def write(folder: Path) -> None:
-    folder.mkdir(parents=True, exist_ok=True)
+    from ..io.outputs import replacing
     for a in SCENARIOS:
         t, k = simulate(a)
-        np.savetxt(folder / f"{a}.csv", np.column_stack([t, k]), fmt="%.9e", delimiter=",", header=header(a),
-                   comments="")
+        with replacing(folder / f"{a}.csv", "folder", picked=True) as tmp:
+            np.savetxt(tmp, np.column_stack([t, k]), fmt="%.9e", delimiter=",", header=header(a), comments="")
 
 
 def read(folder: Path, actuator_id: str) -> Tuple[np.ndarray, np.ndarray]:

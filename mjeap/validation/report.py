@@ -59,7 +59,7 @@ def write_json(experiments: List[Experiment], path: Path, pending: Sequence[str]
            "not_run": list(pending),
            "experiments": [{"name": e.name, "title": e.title, "seconds": round(e.seconds, 2), "passed": e.passed,
                             "notes": e.notes, "checks": [c.as_dict() for c in e.checks]} for e in experiments]}
-    with replacing(path) as tmp:
+    with replacing(path, f"--out ({Path(path).name})", picked=True) as tmp:
         tmp.write_text(json.dumps(doc, indent=1, default=float))
 
 
@@ -93,7 +93,7 @@ def write_figure(ex: Experiment, path: Path) -> None:
         ax.set_visible(False)
     fig.suptitle(ex.title, fontsize=11)
     fig.tight_layout()
-    with replacing(path) as tmp:
+    with replacing(path, f"--out ({Path(path).name})", picked=True) as tmp:
         fig.savefig(tmp, dpi=110, format=Path(path).suffix[1:] or "png")
     plt.close(fig)
 
@@ -104,7 +104,7 @@ def write_recording(ex: Experiment, path: Path, figure: Optional[Path] = None) -
     (``figure``: its PNG; curves against other quantities are best read there, with axes and
     units), without matplotlib those curves as a table, and the simulated beams in 3D.
     Written whole (:func:`mjeap.io.outputs.replacing`)."""
-    with replacing(path, "rrd") as tmp:
+    with replacing(path, f"--out ({Path(path).name})", picked=True) as tmp:
         _write_recording(ex, tmp, figure)
 
 
@@ -216,5 +216,5 @@ def write_markdown(experiments: List[Experiment], path: Path, figures: bool, pen
             ""]
     if not figures:
         head += ["(Figures need matplotlib: `pip install -e '.[report]'`.)", ""]
-    with replacing(path) as tmp:
+    with replacing(path, f"--out ({Path(path).name})", picked=True) as tmp:
         tmp.write_text("\n".join(head) + "\n" + "\n".join(markdown_section(e, figures) for e in experiments))

@@ -260,13 +260,13 @@ def test_no_test_imports_a_script_by_path():
 
 
 def test_only_mjeap_is_installed_at_the_top():
-    """Every package of code is a folder of mjeap/; the one package-dir mapping installs
-    data, not code: the model files of assets/mjcf as mjeap.mjcf_files (mjeap.assets.path),
-    no Python module in it."""
+    """Every package of code is a folder of mjeap/; the package-dir mappings install data,
+    not mjeap's code: the model files of assets/mjcf as mjeap.mjcf_files (mjeap.assets.path,
+    no Python module in it) and the examples as mjeap.examples_files (mjeap examples DIR)."""
     cfg = tomllib.loads((ROOT / "pyproject.toml").read_text())["tool"]["setuptools"]
     assert all(p == "mjeap" or p.startswith("mjeap.") for p in cfg["packages"])
     data = cfg.get("package-dir", {})
-    assert data == {"mjeap.mjcf_files": "assets/mjcf"}
+    assert data == {"mjeap.mjcf_files": "assets/mjcf", "mjeap.examples_files": "examples"}
     assert not list((ROOT / "assets" / "mjcf").glob("*.py"))
     assert cfg["package-data"]["mjeap.mjcf_files"] == ["*.xml"]
     on_disk = {m for m, p in MODULES.items() if p.name == "__init__.py"}

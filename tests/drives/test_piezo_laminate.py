@@ -65,7 +65,7 @@ CASES = {"unimorph": UNIMORPH, "asymmetric-bimorph": ASYMMETRIC, "four-piezo-lay
 
 
 def _toml(case, name="laminate", damping=0.05):
-    out = [f'id = "{name}"', 'drive = "piezo"', f"damping_ratio = {damping}",
+    out = [f'id = "{name}"', 'drive.name = "piezo"', f"damping_ratio = {damping}",
            f'voltage_range = ["{case["v"][0]} V", "{case["v"][1]} V"]', "plane_strain = false",
            "[planform]", f'length = {case["L"]}', f'base_width = {case["w"]}']
     for name_, role, E, rho, t, d31, eps, electrode, poling in case["layers"]:

@@ -179,7 +179,7 @@ def test_tapered_bimorph_with_a_tip_block_free_deflection_and_blocked_force(tmp_
 TRILAYER = """
 id = "my-trilayer"
 title = "A thicker PPy trilayer, its own eq. (8) parameters"
-drive = "rc-relaxation"
+drive.name = "rc-relaxation"
 damping_ratio = 0.05
 voltage_range = ["-1 V", "1 V"]
 plane_strain = false
@@ -231,7 +231,7 @@ def test_trilayer_with_rc_relaxation_settles_at_eq_8s_dc_gain_and_bends_by_its_s
 UNIMORPH = """
 id = "my-unimorph"
 title = "A terpolymer unimorph on a Kapton film"
-drive = "electrostrictive"
+drive.name = "electrostrictive"
 damping_ratio = 0.05
 voltage_range = ["-1500 V", "1500 V"]
 plane_strain = false

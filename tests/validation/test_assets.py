@@ -186,3 +186,22 @@ def test_driven_asset_in_plain_mujoco_moves_as_mjeaps_model(actuator_id, represe
     kappa, ref = plain_step_response(m), plain_step_response(ms)
     assert np.ptp(ref) > 0.1 * np.abs(ref).max() > 0
     assert np.max(np.abs(kappa - ref)) <= 1e-9 * np.ptp(ref)
+
+
+@pytest.mark.parametrize("file", [asset_name(a, r) for a, r in ASSETS])     # by file: the cable's runs on 4.x too
+def test_every_file_assets_path_hands_out_loads_on_this_mujoco(file):
+    """mjeap.assets.path hands out only what the installed MuJoCo loads, plain
+    (MjModel.from_xml_path) and through load_mjcf; a representation it cannot build (the
+    cable on 4.x) is refused with the reason, and its file indeed does not load here."""
+    from mjeap.model.mjcf import BUILDERS
+    actuator_id, representation = next((a, r) for a, r in ASSETS if asset_name(a, r) == file)
+    why = BUILDERS[representation].unavailable_reason()
+    if why is None:
+        p = path(actuator_id, representation)
+        assert mujoco.MjModel.from_xml_path(str(p)).nbody > 2
+        assert load_mjcf(p).nbody > 2
+        return
+    with pytest.raises(ParameterError, match="does not load on this MuJoCo"):
+        path(actuator_id, representation)
+    with pytest.raises(Exception):
+        mujoco.MjModel.from_xml_path(str(ASSET_DIR / asset_name(actuator_id, representation)))

@@ -32,7 +32,7 @@ from typing import List, Optional, Sequence
 from ...io import csvio
 from ...errors import (DivergenceError, MjeapError, OutputError, ParameterError, UnknownNameError, check_integer,
                       sigterm_as_interrupt)
-from ...io.outputs import hold
+from ...io.outputs import appending, check_outputs, hold, output_kind
 from ...model.laminate import FieldWarning
 from . import metrics as _metrics      # its registries, read where a point runs
 from .points import (PARAMETERS, _check_names, _duration, _scene, _wave_text, check_design_size, check_settings,
@@ -483,7 +483,14 @@ def run_sweep(points: Sequence[dict], path, metrics: Sequence[str] = ("peak_to_p
               for i in record]
     check_settings(points, base)
     check_metric_settings(points, base, metrics)
-    path.parent.mkdir(parents=True, exist_ok=True)
+    # every output before any work: the CSV, and the recordings it names itself (point-ID.rrd), none a
+    # link or one of the sweep's actuator files
+    folder = Path(rrd_dir) if rrd_dir is not None else path.parent / (path.stem + "-rrd")
+    if record and rrd_dir is None and os.path.islink(folder):
+        raise ParameterError("record", str(folder), "a folder for the recordings that is not a symbolic link",
+                             "mjeap names it itself (next to the CSV): a planted link is never followed")
+    recordings = {f"record (point {i})": folder / f"point-{point_id(points[i], base, metrics)}.rrd" for i in record}
+    check_outputs(inputs=sweep_inputs(points, base), picked=recordings, path=path, **recordings)
     # the CSV's lock for the whole sweep (PATH.lock): a second sweep on it, or a run writing it,
     # is refused (it would compute every point twice and duplicate rows)
     with hold(path, "path", holder="mjeap sweep"):
@@ -491,10 +498,21 @@ def run_sweep(points: Sequence[dict], path, metrics: Sequence[str] = ("peak_to_p
                            bool(share_error_models))
 
 
+def sweep_inputs(points: Sequence[dict], base: Optional[dict] = None) -> list:
+    """The files a study reads (the actuator files its points and settings name), as
+    (name, path) pairs: none may be one of its outputs (:func:`mjeap.io.outputs.check_inputs`)."""
+    from ...model.actuator_file import is_actuator_file
+    files = dict.fromkeys(str(p["actuator"]) for p in [*points, base or {}]
+                          if isinstance(p.get("actuator"), (str, Path)) and is_actuator_file(p["actuator"]))
+    return [("actuator file", f) for f in files]
+
+
 def _run_locked(points, path, metrics, base, executor, workers, scheduler, record, rrd_dir, progress, share=True):
-    _drop_torn_row(path)
+    stream = output_kind(path) == "stream"             # /dev/stdout, a FIFO: written through, never read back
+    if not stream:
+        _drop_torn_row(path)
     done_ids, header, delimiter = set(), None, ","
-    if path.exists() and path.stat().st_size > 0:       # resumed: read as users' CSVs are, appended in its form
+    if not stream and path.exists() and path.stat().st_size > 0:   # resumed: read as users' CSVs are, appended in its form
         header, rows, delimiter = _read_sweep_csv(path)
         done_ids = {row["point_id"] for row in rows}
     rrd_dir = str(rrd_dir or path.parent / (path.stem + "-rrd"))
@@ -504,8 +522,7 @@ def _run_locked(points, path, metrics, base, executor, workers, scheduler, recor
     skipped = len(points) - len(jobs)
     estimates = [f"estimated_error.{m}" for m in targeted_metrics(metrics)] if _at_target(points, base) else []
     columns = ["point_id", *sorted({k for p in points for k in p}), *metrics, *estimates, "error", "wall_s", "settings"]
-    path.parent.mkdir(parents=True, exist_ok=True)
-    new_file = not path.exists() or path.stat().st_size == 0
+    new_file = stream or not path.exists() or path.stat().st_size == 0
     if not new_file:
         if header != columns:
             raise ParameterError("path", str(path), f"a CSV of this sweep (columns {columns}); it has {header}")
@@ -528,9 +545,9 @@ class _RowFile:
     whole row and raises :class:`OutputError` saying how many rows are kept, so that a rerun
     resumes from them (a stream, e.g. /dev/stdout, is written through)."""
 
-    def __init__(self, path: Path, delimiter: str = ","):
+    def __init__(self, path: Path, delimiter: str = ",", name: str = "path"):
         self.path = path
-        self.fd = os.open(path, os.O_WRONLY | os.O_APPEND | os.O_CREAT | os.O_CLOEXEC, 0o666)
+        self.fd = appending(path, name)               # never through a link (mjeap.io.outputs)
         self.regular = stat.S_ISREG(os.fstat(self.fd).st_mode)
         self.buf = io.StringIO()
         self.writer = csvio.writer(self.buf, delimiter=delimiter)
