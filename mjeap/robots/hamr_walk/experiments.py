@@ -171,7 +171,8 @@ from .. import hamr_leg
 from ..registry import summary
 from .model import (BIAS, CONTACT_WIDTH_FRACTION, FOOT_RADIUS, FREQUENCY_RANGE, LEGS, MU,
                     SEGMENTS, body_position, body_rotation, build, clearances, contact_sizing, design, feet,
-                    ground_rotation, model_summary, roll_pitch)
+                    foot_forces, ground_force, ground_rotation, GroundImpulses, metering, model_summary,
+                    roll_pitch)
 
 AMPLITUDE = 0.5 * BIAS          # V, full amplitude: the signal swings 0..V_bias
 PAPER_SPEED, PAPER_FREQUENCY = 0.5, 65.0      # m/s at Hz, seed 003
@@ -245,13 +246,22 @@ def walk(system: System, frequency: float, amplitude: float = AMPLITUDE, settle:
     :class:`TrotPhaseControllers`, see :func:`walk_closed_loop`). Returns the samples (SI,
     world): time, body position and rotation, the feet's positions and velocities, which feet touch the ground, the
     deepest penetration, the chassis's and the legs' lowest points above the ground
-    (:func:`clearances`); the rollout's result; the measuring window's start ``t0``."""
+    (:func:`clearances`); the rollout's result; the measuring window's start ``t0``; and
+    per sample the ground's force on each foot (``foot_force``, N, at the sample, as
+    mj_contactForce reads it) and the mean over the interval since the previous sample
+    (``foot_force_mean``; ``ground_force_mean`` in all, from the impulses of every step,
+    model.GroundImpulses), per foot the steps it carried load and its touch-downs at the
+    step's resolution (``loaded_steps``, ``onsets``; ``interval_steps``) and the robot's
+    momentum (``momentum``, N s)."""
     bias = system.actuators[0].drive.params["bias"]
     settle, measure = trot_durations(frequency, settle, measure)
     fid = [mujoco.mj_name2id(system.model, mujoco.mjtObj.mjOBJ_GEOM, f"{leg}/foot") for leg in LEGS]
     sid = [mujoco.mj_name2id(system.model, mujoco.mjtObj.mjOBJ_SITE, f"{leg}/foot") for leg in LEGS]
-    rows = {k: [] for k in ("body", "R", "feet", "feet_velocity", "contact", "penetration", "chassis_clearance",
-                            "leg_clearance")}
+    rows = {k: [] for k in ("body", "R", "feet", "feet_velocity", "contact", "foot_force", "ground_force",
+                            "foot_force_mean", "ground_force_mean", "loaded_steps", "onsets", "interval_steps", "momentum",
+                            "penetration", "chassis_clearance", "leg_clearance")}
+    meter = GroundImpulses(system)
+    bid = mujoco.mj_name2id(system.model, mujoco.mjtObj.mjOBJ_BODY, "body")
     v6 = np.zeros(6)
 
     def on_sample(sy):
@@ -266,18 +276,33 @@ def walk(system: System, frequency: float, amplitude: float = AMPLITUDE, settle:
         rows["feet_velocity"].append(np.array(vel) * sy.units.length / sy.units.time)
         touching = {d.contact[i].geom1 for i in range(d.ncon)} | {d.contact[i].geom2 for i in range(d.ncon)}
         rows["contact"].append([g in touching for g in fid])
+        rows["foot_force"].append(foot_forces(sy, fid))
+        rows["ground_force"].append(ground_force(sy))
+        got = meter.take()                      # the steps since the previous sample
+        span = max(got["steps"], 1) * sy.timestep
+        rows["foot_force_mean"].append(got["foot"] / span)
+        rows["ground_force_mean"].append(got["total"] / span)
+        rows["loaded_steps"].append(got["loaded_steps"])
+        rows["onsets"].append(got["onsets"])
+        rows["interval_steps"].append(got["steps"])
+        mujoco.mj_subtreeVel(m, d)              # the robot's momentum (N s, world) at this state
+        rows["momentum"].append(m.body_subtreemass[bid] * d.subtree_linvel[bid] * sy.units.mass * sy.units.length
+                                / sy.units.time)
         rows["penetration"].append(sy.penetration())
         low = clearances(sy)
         rows["chassis_clearance"].append(low[0])
         rows["leg_clearance"].append(low[1])
 
     volts = None if controller is not None else trot_voltages(frequency, amplitude, bias, lift_amplitude=lift_amplitude)
-    res = system.rollout(volts, settle + measure, sample_interval=1.0 / (samples_per_cycle * frequency),
-                         on_sample=on_sample, controller=controller)
+    with metering(meter):
+        res = system.rollout(volts, settle + measure, sample_interval=1.0 / (samples_per_cycle * frequency),
+                             on_sample=on_sample, controller=controller)
     run = {k: np.array(v) for k, v in rows.items()}
     run.update(time=res.time[:len(rows["body"])], result=res, frequency=float(frequency), amplitude=float(amplitude),
                lift_amplitude=float(amplitude if lift_amplitude is None else lift_amplitude),
-               t0=float(settle), ground=ground_rotation(system))
+               t0=float(settle), ground=ground_rotation(system),
+               weight_n=float(system.model.body_subtreemass[bid] * np.linalg.norm(system.model.opt.gravity)
+                              * system.units.force))
     return run
 
 
@@ -341,6 +366,27 @@ def stand(system: System, duration: float = 1.0, after: float = 0.5, window: flo
             "body_height_range_m": float(np.ptp(pos[:, 0, 2]) * u.length)}
 
 
+def force_balance(run: dict) -> dict:
+    """Momentum along the ground's normal over a :func:`walk`'s measuring window: the mean of
+    the ground's contact force on the robot (N, from the impulses of every step,
+    ``ground_force_mean``) against what Newton's second law requires of it, the weight's
+    normal share plus the change of the robot's normal momentum over the window divided by
+    its duration; their ratio - 1. Beside it the mean of the forces at the samples alone
+    (``sampled_force_balance_error``: a landing's force lasts a few steps, so the samples
+    miss or catch it)."""
+    t, up = run["time"], run["ground"][:, 2]
+    k0 = int(np.argmax(t >= run["t0"] - 1e-12))
+    T = t[-1] - t[k0]
+    steps = np.asarray(run["interval_steps"][k0 + 1:], dtype=float)
+    mean = float((run["ground_force_mean"][k0 + 1:] @ up) @ steps / steps.sum())
+    fz = run["ground_force"][k0:] @ up
+    sampled = float(np.sum(0.5 * (fz[1:] + fz[:-1]) * np.diff(t[k0:])) / T)
+    p = run["momentum"][k0:] @ up
+    need = float(run["weight_n"] * up[2] + (p[-1] - p[0]) / T)
+    return {"mean_normal_force_n": mean, "momentum_normal_force_n": need, "weight_n": run["weight_n"],
+            "force_balance_error": mean / need - 1.0, "sampled_force_balance_error": sampled / need - 1.0}
+
+
 def walk_metrics(run: dict) -> dict:
     """The read-outs of a :func:`walk` over its measuring window (see the module text), with
     ``upright`` (:func:`upright`)."""
@@ -369,6 +415,14 @@ def walk_metrics(run: dict) -> dict:
     v_t = np.linalg.norm(vf - (vf @ up)[..., None] * up, axis=-1)
     threshold = max(SLIDE_FRACTION * stance_speed, 1e-4)
     slides = (v_t > threshold) & c
+    # contact: the ground's normal force on a foot, at the sample (instantaneous) and over
+    # every step of the interval before it (its impulse; the steps with a positive force)
+    touch_now = (run["foot_force"] @ up)[k] > 0.0                       # (n, 4)
+    ki = np.flatnonzero(k)[1:]                                           # the intervals inside the window
+    touch = (run["foot_force_mean"] @ up)[ki] > 0.0
+    loaded = np.asarray(run["loaded_steps"])[ki]
+    steps = np.asarray(run["interval_steps"])[ki]
+    near = (gap < STANCE_GAP)[ki]
     out = {
         "frequency_hz": f, "amplitude_v": run["amplitude"], "lift_amplitude_v": run.get("lift_amplitude"),
         "speed_m_s": speed, "lateral_drift_m_s": lateral,
@@ -387,6 +441,21 @@ def walk_metrics(run: dict) -> dict:
         "max_foot_speed_m_s": float(np.linalg.norm(run["feet_velocity"], axis=-1).max()),
         # stance onsets per foot per cycle: ~1 a trot, several a foot bouncing, < 1 a body in flight
         "touchdowns_per_cycle": float(((~c[:-1]) & c[1:]).sum() / 4 / (duration * f)),
+        # the same read from the normal force: the share of the steps with a foot loaded (every
+        # step; and at the samples alone), the onsets per foot and cycle of the intervals in
+        # which a foot carried load, and of the samples with a foot within STANCE_GAP of the
+        # ground the share whose interval it carried load in (1: a stance foot is in contact;
+        # and at the sample's instant alone)
+        "contact_duty_factor": float(loaded.sum() / (4 * steps.sum())),         # the share of every step
+        "contact_duty_factor_sampled": float(touch_now.mean()),                  # at the samples alone
+        "contact_touchdowns_per_cycle": float(((~touch[:-1]) & touch[1:]).sum() / 4 / (duration * f)),
+        "contact_when_near": float(touch[near].mean()) if near.any() else None,
+        "contact_when_near_sampled": float(touch_now[1:][near].mean()) if near.any() else None,
+        # the load's onsets at the step's resolution (a flickering contact: many per cycle)
+        "step_touchdowns_per_cycle": float(np.asarray(run["onsets"])[ki].sum() / 4 / (duration * f)),
+        # momentum: the mean of the feet's vertical (ground-normal) forces over the window against
+        # the weight plus the change of the robot's momentum along the normal (force_balance)
+        **force_balance(run),
         # over the whole run (a roll-over may come before the window): below 0, through the ground
         "min_chassis_clearance_m": float(np.min(run["chassis_clearance"])),
         "min_leg_clearance_m": float(np.min(run["leg_clearance"])),
