@@ -23,7 +23,8 @@ LAYER_FILES = {
                      "test_validation",
                      "test_controllers", "test_hamr_leg", "test_environment", "test_gymnasium_env"),
     "robots": ("test_robots", "test_gripper", "test_hamr_leg_linkage", "test_robobee_wing", "test_hamr_walk",
-               "test_hamr_walk_rest", "test_hamr_walk_loops", "test_hamr_walk_study", "test_gym_robots"),
+               "test_hamr_walk_rest", "test_hamr_walk_loops", "test_hamr_walk_study", "test_hamr_walk_contact",
+               "test_gym_robots"),
     "contracts": ("test_contracts", "test_early_errors", "test_silent_answers", "test_reliability", "test_registries"),
 }
 #: test file (stem) -> its layer

@@ -441,12 +441,13 @@ def walk_metrics(run: dict) -> dict:
         "max_foot_speed_m_s": float(np.linalg.norm(run["feet_velocity"], axis=-1).max()),
         # stance onsets per foot per cycle: ~1 a trot, several a foot bouncing, < 1 a body in flight
         "touchdowns_per_cycle": float(((~c[:-1]) & c[1:]).sum() / 4 / (duration * f)),
-        # the same read from the normal force: the share of the steps with a foot loaded (every
-        # step; and at the samples alone), the onsets per foot and cycle of the intervals in
-        # which a foot carried load, and of the samples with a foot within STANCE_GAP of the
-        # ground the share whose interval it carried load in (1: a stance foot is in contact;
-        # and at the sample's instant alone)
-        "contact_duty_factor": float(loaded.sum() / (4 * steps.sum())),         # the share of every step
+        # the same read from the normal force: the share of the sample intervals in which a foot
+        # carried load (a positive normal impulse; and of every step, and at the samples alone),
+        # the onsets of those intervals per foot and cycle, and of the samples with a foot within
+        # STANCE_GAP of the ground the share whose interval it carried load in (1: a stance
+        # foot is in contact; and at the sample's instant alone)
+        "contact_duty_factor": float(touch.mean()),                              # intervals with a load
+        "loaded_step_fraction": float(loaded.sum() / (4 * steps.sum())),        # every step with a load
         "contact_duty_factor_sampled": float(touch_now.mean()),                  # at the samples alone
         "contact_touchdowns_per_cycle": float(((~touch[:-1]) & touch[1:]).sum() / 4 / (duration * f)),
         "contact_when_near": float(touch[near].mean()) if near.any() else None,
