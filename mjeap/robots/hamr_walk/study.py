@@ -274,8 +274,12 @@ def gait_figure(rows: Sequence[dict], path) -> None:
             y = np.array([r[key] for r in rs])
             up = np.array([r["upright_whole_run"] for r in rs])
             ax.plot(f, y, "-", color=colours[a], lw=1, alpha=0.6)
-            ax.plot(f[up], y[up], "o", color=colours[a], label=f"mjeap, {a:g} V ({'full drive' if a == hw.AMPLITUDE else 'reduced'}): upright")
-            ax.plot(f[~up], y[~up], "o", mfc="none", color=colours[a], label=f"mjeap, {a:g} V: tilted past {hw.UPRIGHT_DEG:g} deg")
+            kind = "full drive" if a == hw.AMPLITUDE else "reduced"
+            if up.any():
+                ax.plot(f[up], y[up], "o", color=colours[a], label=f"mjeap, {a:g} V ({kind}): upright")
+            if (~up).any():
+                ax.plot(f[~up], y[~up], "o", mfc="none", color=colours[a],
+                        label=f"mjeap, {a:g} V ({kind}): tilted past {hw.UPRIGHT_DEG:g} deg")
         ax.axhline(0.0, color="0.6", lw=0.8)
         ax.set_xlabel("stride frequency (Hz)")
         ax.set_ylabel(f"forward speed ({unit})")
