@@ -45,6 +45,18 @@ default windows. The motion is chaotic (a small change of mu or segments moves t
 numbers): single runs, not converged values. Re-measured with the contact of
 :func:`~mjeap.robots.hamr_walk.model.contact_parameters` (issue: the walker's contact);
 "before" is the 2-step contact under 'implicitfast', after hamr_leg's stage centre-of-mass fix (commit 41b82c0).
+- Issue 46 (docs/robots/hamr-walk.md, hamr-walk-gait.md; 0.3 s settling, 0.2 s measured): the
+  solver at SOLVER_TOLERANCE and the actuators' travel within ACTUATOR_RANGE. The contact
+  forces (sensors, every step) balance the robot's momentum within 2e-5 under either
+  integrator (+5.9 % under 'discrete' at MuJoCo's tolerance 1e-8). Full drive: 10 Hz 0.097 m/s
+  upright (12 deg), 20 Hz 0.062 m/s upright (26 deg; rolled over before), 30-65 Hz tilted to
+  33-67 deg (65 Hz 0.017 m/s; rolled onto its back before): the feet's 3.2-3.6 mm stroke
+  accelerates them at more than g above 9 Hz and throws the body into flights (its top at
+  18-24 mm), landing tilted; under 5 x gravity the 20 Hz trot runs upright at 2.4 deg. At
+  10 Hz the contact duty factor (sample intervals with a load) is 0.38, every sample with a
+  foot within STANCE_GAP has it loaded over its interval (at the instant alone 0.30), 2.65
+  touch-downs per foot and cycle (444 at the step's resolution: a sliding foot's load comes
+  in impulses, study.sliding_contact). The table below is from before issue 46.
 - At rest (:func:`stand`, no drive, 1 s): after 0.5 s the feet's normal forces add up to the
   weight within 6e-8 at every step, all four feet down at every step; the body moves along
   the ground at 1e-10 m/s, each foot 0.12 um/s (the legs splay under the weight: 0.21 of
@@ -258,7 +270,8 @@ def walk(system: System, frequency: float, amplitude: float = AMPLITUDE, settle:
     fid = [mujoco.mj_name2id(system.model, mujoco.mjtObj.mjOBJ_GEOM, f"{leg}/foot") for leg in LEGS]
     sid = [mujoco.mj_name2id(system.model, mujoco.mjtObj.mjOBJ_SITE, f"{leg}/foot") for leg in LEGS]
     rows = {k: [] for k in ("body", "R", "feet", "feet_velocity", "contact", "foot_force", "ground_force",
-                            "foot_force_mean", "ground_force_mean", "loaded_steps", "onsets", "interval_steps", "momentum",
+                            "foot_force_mean", "ground_force_mean", "loaded_steps", "onsets", "interval_steps",
+                            "momentum",
                             "penetration", "chassis_clearance", "leg_clearance")}
     meter = GroundImpulses(system)
     bid = mujoco.mj_name2id(system.model, mujoco.mjtObj.mjOBJ_BODY, "body")
@@ -831,7 +844,8 @@ def _experiments(a) -> None:
                 "speed_over_paper": m["speed_m_s"] / PAPER_SPEED if m["upright"] else None,
                 "max_abs_roll_deg": m["max_abs_roll_deg"], "max_abs_pitch_deg": m["max_abs_pitch_deg"],
                 "cause": "at full drive the feet's stroke (3.2-3.6 mm, A omega^2 = 60 g at 65 Hz) throws the 1.43 g "
-                         "body into flights it lands from tilted (docs/robots/hamr-walk.md; mjeap.robots.hamr_walk.study)"}
+                         "body into flights it lands from tilted (docs/robots/hamr-walk.md; "
+                         "mjeap.robots.hamr_walk.study)"}
     # the issue's check: the full-drive trot upright at every frequency of 10-65 Hz run here
     band = [r for r in out["runs"] if 10.0 <= r["frequency_hz"] <= PAPER_FREQUENCY]
     out["upright_10_to_65_hz"] = {f"{r['frequency_hz']:g}": r["upright"] for r in band}

@@ -327,7 +327,8 @@ class GroundImpulses:
     def __init__(self, system: System):
         m = system.model
         self.system = system
-        adr = [int(m.sensor_adr[m.sensor(name).id]) for name in [f"{leg}/ground_force" for leg in LEGS] + ["ground_force"]]
+        names = [f"{leg}/ground_force" for leg in LEGS] + ["ground_force"]
+        adr = [int(m.sensor_adr[m.sensor(name).id]) for name in names]
         self._idx = (np.array(adr)[:, None] + np.arange(3)).ravel()           # the feet's, then the total
         mujoco.mj_kinematics(m, system.data)
         self._normal = ground_rotation(system)[:, 2]

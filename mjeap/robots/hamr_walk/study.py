@@ -1,5 +1,8 @@
 """Why HAMR-VI (:mod:`mjeap.robots.hamr_walk`) rolls over at 65 Hz at the paper's full drive
-(issue 25): one-parameter studies of the 65 Hz trot, each against the default model.
+(issue 25): one-parameter studies of the 65 Hz trot, each against the default model; why a
+stance foot's contact flickers (:func:`sliding_contact`) and the trot's speed per frequency
+beside the robot's (:func:`gait_study`, :func:`gait_main`; issue 46, whose findings are in
+docs/robots/hamr-walk.md: the findings below predate its solver tolerance and actuator travel).
 
 :func:`rolling_study` runs ``hamr_walk.walk(system, 65.0)`` and ``walk_metrics`` for the
 default model and for one changed parameter at a time (build options of hamr_walk and the
