@@ -700,8 +700,9 @@ def upright(metrics: dict) -> bool:
 def write_recording(path, system: System, run: dict) -> None:
     """The run in 3D at true scale (the body, the eight actuators, the legs, the feet) over a
     5 mm ground grid, each foot's trail and the body's path; plots of the body's forward
-    speed (instantaneous, per cycle, the paper's 0.5 m/s at 65 Hz), its roll and pitch and
-    the feet's clearance."""
+    speed (instantaneous, per cycle, the paper's 0.5 m/s at 65 Hz), its roll and pitch, the
+    feet's clearance and the ground's normal force on each foot over each sample interval
+    (from every step's contact sensors) beside the weight."""
     import rerun as rr
     import rerun.blueprint as rrb
     from ...io.recording import write_system_recording, x_axis, y_axis
@@ -716,6 +717,7 @@ def write_recording(path, system: System, run: dict) -> None:
     v_cyc = np.diff(x_cyc) * f
     rp = np.degrees(np.array([roll_pitch(R, G) for R in run["R"]]))
     clearance = run["feet"] @ up - FOOT_RADIUS
+    load = run["foot_force_mean"] @ up          # each interval's mean (the impulses of every step)
     colours = {"FL": [230, 80, 60], "FR": [60, 120, 230], "RL": [240, 170, 40], "RR": [60, 180, 90]}
 
     def extra(rec):
@@ -740,7 +742,12 @@ def write_recording(path, system: System, run: dict) -> None:
                 ("walk/attitude/roll", "roll (deg)", [220, 60, 60], t, rp[:, 0]),
                 ("walk/attitude/pitch", "pitch (deg)", [40, 110, 220], t, rp[:, 1])) + tuple(
                 (f"walk/clearance/{leg}", f"{leg} foot clearance (m)", colours[leg], t, clearance[:, i])
-                for i, leg in enumerate(LEGS)):
+                for i, leg in enumerate(LEGS)) + tuple(
+                (f"walk/ground_force/{leg}", f"{leg}: ground's normal force, interval mean (N)", colours[leg], t,
+                 load[:, i]) for i, leg in enumerate(LEGS)) + (
+                ("walk/ground_force/total", "all feet (N)", [40, 40, 40], t, load.sum(axis=1)),
+                ("walk/ground_force/weight", f"weight ({run['weight_n'] * 1e3:.3g} mN)", [150, 150, 150], t,
+                 np.full(len(t), run["weight_n"]))):
             rec.log(ent, rr.SeriesLines(names=label, colors=[colour]), static=True)
             rec.send_columns(ent, indexes=[rr.TimeColumn("time", duration=ts)] if ts is not t else tc,
                              columns=rr.Scalars.columns(scalars=np.asarray(values, dtype=float)))
@@ -750,7 +757,10 @@ def write_recording(path, system: System, run: dict) -> None:
              rrb.TimeSeriesView(origin="/walk/attitude", name="roll and pitch (deg)", axis_y=y_axis(rp),
                                 axis_x=x_axis(t)),
              rrb.TimeSeriesView(origin="/walk/clearance", name="foot clearance above the ground (m)",
-                                axis_y=y_axis(clearance), axis_x=x_axis(t)))
+                                axis_y=y_axis(clearance), axis_x=x_axis(t)),
+             rrb.TimeSeriesView(origin="/walk/ground_force", name="the ground's normal force on each foot, mean "
+                                "over each sample interval (N; its mean over the window balances the momentum)",
+                                axis_y=y_axis(load), axis_x=x_axis(t)))
     if "errors" in run:                          # a walk_closed_loop: its phase errors per cycle
         extra, views = _with_phase_plots(run, extra, views)
     write_system_recording(path, run["result"], system, extra=extra, views=views, actuator_views=False)
