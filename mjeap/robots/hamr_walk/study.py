@@ -1,5 +1,8 @@
 """Why HAMR-VI (:mod:`mjeap.robots.hamr_walk`) rolls over at 65 Hz at the paper's full drive
-(issue 25): one-parameter studies of the 65 Hz trot, each against the default model.
+(issue 25): one-parameter studies of the 65 Hz trot, each against the default model; why a
+stance foot's contact flickers (:func:`sliding_contact`) and the trot's speed per frequency
+beside the robot's (:func:`gait_study`, :func:`gait_main`; issue 46, whose findings are in
+docs/robots/hamr-walk.md: the findings below predate its solver tolerance and actuator travel).
 
 :func:`rolling_study` runs ``hamr_walk.walk(system, 65.0)`` and ``walk_metrics`` for the
 default model and for one changed parameter at a time (build options of hamr_walk and the
@@ -60,6 +63,9 @@ tests is not in the sources here.
 from __future__ import annotations
 
 from typing import Optional, Sequence
+
+import mujoco
+import numpy as np
 
 from ...errors import ParameterError
 from . import experiments as hw
@@ -145,3 +151,197 @@ def incline_study(mus: Sequence[float] = (model.MU, 0.8, 1.2), frequency: float 
     if not len(mus):
         raise ParameterError("mus", mus, "at least one friction coefficient")
     return [{"mu": float(mu), **hw.max_incline(frequency, mu=float(mu), **kw)} for mu in mus]
+
+
+# ---- why a stance foot flickers, and the speed per frequency (issue: HAMR-VI runs like the robot) ----
+#: m/s: the sliding speeds of the walker's stance feet (10 Hz full drive: 0.05-0.15 m/s)
+SLIDE_SPEEDS = (0.0, 0.03, 0.1, 0.3)
+
+
+def sliding_contact(speeds: Sequence[float] = SLIDE_SPEEDS, duration: float = 0.02, load: float = 0.25,
+                    contact: Optional[dict] = None) -> list:
+    """A stance foot on the walker's ground contact, alone: a FOOT_RADIUS sphere carrying
+    ``load`` of the robot's weight (its mass), driven to slide at each of ``speeds`` (m/s,
+    a stiff velocity servo on a slide joint; the height free), stepped as the walker is
+    (its timestep, 'discrete', contact_parameters; ``contact``: options of MuJoCo's own to
+    change, e.g. {'cone': 'pyramidal'}, {'noslip_iterations': 20}, {'impratio': 1}). After
+    a quarter of ``duration`` settling, per speed: the share of the steps with the sphere
+    loaded (a positive normal force), its mean height above the ground (m) and the mean
+    normal force against the load (Newton: 1 whatever the steps). MuJoCo resolves a
+    contact's normal and friction forces in one cost: a sliding contact is pushed apart
+    (tested), so its load comes as impulses a few steps apart."""
+    from ...simulation.system import ContactParameters
+    ref = model.build()
+    h, u = ref.timestep, ref.units
+    c = model.contact_parameters(h)
+    opts = dict(contact or {})
+    cone = opts.pop("cone", c.cone)
+    mass = load * model.TOTAL_MASS / u.mass
+    xml = f"""<mujoco><option gravity="0 0 -9.80665e-3" integrator="discrete"/>
+    <worldbody><geom name="ground" type="plane" size="1000 1000 1"/>
+    <body pos="0 0 {model.FOOT_RADIUS / u.length}"><joint name="x" type="slide" axis="1 0 0" damping="0"/>
+    <joint name="z" type="slide" axis="0 0 1"/>
+    <geom name="foot" type="sphere" size="{model.FOOT_RADIUS / u.length}" mass="{mass}"/></body></worldbody>
+    <actuator><velocity joint="x" kv="{1e3 * mass / (h / u.time)}"/></actuator></mujoco>"""
+    spec = mujoco.MjSpec.from_string(xml)
+    ContactParameters(**{**c.__dict__, "cone": cone}).apply(spec, h / u.time, model.FOOT_RADIUS / u.length,
+                                                           u.length)
+    spec.option.timestep = h / u.time
+    spec.option.tolerance = model.SOLVER_TOLERANCE
+    m = spec.compile()
+    for k, v in opts.items():
+        setattr(m.opt, k, v)
+    rows = []
+    f6 = np.zeros(6)
+    for v in speeds:
+        d = mujoco.MjData(m)
+        d.ctrl[0] = v * u.time / u.length
+        n = int(round(duration / h))
+        fn, z = np.zeros(n), np.zeros(n)
+        for k in range(n):
+            mujoco.mj_step(m, d)
+            total = 0.0
+            for i in range(d.ncon):
+                mujoco.mj_contactForce(m, d, i, f6)
+                total += f6[0]
+            fn[k], z[k] = total, d.qpos[1]
+        keep = slice(n // 4, n)
+        w = mass * 9.80665e-3
+        rows.append({"speed_m_s": float(v), "loaded_step_share": float((fn[keep] > 0).mean()),
+                     "mean_height_m": float(z[keep].mean() * u.length),
+                     "mean_normal_force_over_load": float(fn[keep].mean() / w)})
+    return rows
+
+
+#: Hz and V: the gait study's trots (full drive, half and 30 V)
+GAIT_FREQUENCIES = (10.0, 20.0, 30.0, 40.0, 50.0, 65.0)
+GAIT_AMPLITUDES = (hw.AMPLITUDE, 50.0, 30.0)
+#: mm per cycle and m/s the robot is published at (see docs/robots/hamr-walk.md, Gait study)
+PUBLISHED = (
+    {"source": "Jayaram et al. 2018 (section 6.2)", "frequency_hz": 65.0, "speed_m_s": 0.5,
+     "what": "maximum forward velocity, 'approximately 0.5 m/s at a pre-resonant drive frequency of 65 Hz'"},
+    {"source": "Doshi et al. 2019, arXiv 1901.09065 (abstract)", "frequency_hz": None, "mm_per_cycle": 10.87,
+     "what": "fastest planned gait, 'a maximum of 10.87 mm/cycle, 15 % faster than previously measured'"},
+    {"source": "Doshi et al. 2019, arXiv 1901.09065 (abstract)", "frequency_hz": None, "mm_per_cycle": 10.87 / 1.15,
+     "what": "the previously measured best, 10.87 / 1.15 = 9.45 mm/cycle"},
+)
+
+
+def gait_study(frequencies: Sequence[float] = GAIT_FREQUENCIES, amplitudes: Sequence[float] = GAIT_AMPLITUDES,
+               settle: float = 0.3, measure: float = 0.2, on_row=None) -> list:
+    """The trot's speed per frequency and amplitude: per (frequency, amplitude) a
+    :func:`study_run` of the default model over ``measure`` s after ``settle`` s (the
+    issue's bands: after 0.3 s), with speed (m/s and mm per cycle), upright, the largest
+    roll and pitch over the whole run, the contact read-outs and the body's highest point
+    (its hops). ``on_row(row)`` is called after each run (to write as it goes)."""
+    if not len(frequencies) or not len(amplitudes):
+        raise ParameterError("frequencies, amplitudes", (frequencies, amplitudes), "at least one of each")
+    d = model.design()
+    rows = []
+    for a in amplitudes:
+        for f in frequencies:
+            run = hw.walk(model.build(d=d), float(f), float(a), settle=settle, measure=measure)
+            m = hw.walk_metrics(run)
+            rp = np.degrees(np.abs(np.array([model.roll_pitch(R, run["ground"]) for R in run["R"]])))
+            row = {"frequency_hz": float(f), "amplitude_v": float(a), "speed_m_s": m["speed_m_s"],
+                   "mm_per_cycle": m["speed_m_s"] / f * 1e3,
+                   "upright_whole_run": bool(rp.max() < hw.UPRIGHT_DEG),
+                   "max_abs_roll_deg_whole_run": float(rp[:, 0].max()),
+                   "max_abs_pitch_deg_whole_run": float(rp[:, 1].max()),
+                   "body_height_max_m": m["body_height_range_m"][1], "wall_s": m["wall_time_s"],
+                   **{k: m[k] for k in ("kinematic_speed_m_s", "duty_factor", "contact_duty_factor",
+                                        "loaded_step_fraction", "contact_touchdowns_per_cycle",
+                                        "step_touchdowns_per_cycle", "contact_when_near", "force_balance_error",
+                                        "slip_fraction")}}
+            rows.append(row)
+            if on_row is not None:
+                on_row(row)
+    return rows
+
+
+def gait_figure(rows: Sequence[dict], path) -> None:
+    """The gait study's figure (PNG at ``path``): mm per cycle and m/s against frequency per
+    drive amplitude (filled: upright over the whole run; open: tilted past UPRIGHT_DEG),
+    beside the published HAMR-VI numbers (PUBLISHED). Needs matplotlib (the report extra)."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from ...io.outputs import replacing
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.6))
+    amps = sorted({r["amplitude_v"] for r in rows}, reverse=True)
+    colours = dict(zip(amps, ("tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown")))
+    for ax, key, unit in ((axes[0], "mm_per_cycle", "mm per cycle"), (axes[1], "speed_m_s", "m/s")):
+        for a in amps:
+            rs = sorted((r for r in rows if r["amplitude_v"] == a), key=lambda r: r["frequency_hz"])
+            f = np.array([r["frequency_hz"] for r in rs])
+            y = np.array([r[key] for r in rs])
+            up = np.array([r["upright_whole_run"] for r in rs])
+            ax.plot(f, y, "-", color=colours[a], lw=1, alpha=0.6)
+            kind = "full drive" if a == hw.AMPLITUDE else "reduced"
+            if up.any():
+                ax.plot(f[up], y[up], "o", color=colours[a], label=f"mjeap, {a:g} V ({kind}): upright")
+            if (~up).any():
+                ax.plot(f[~up], y[~up], "o", mfc="none", color=colours[a],
+                        label=f"mjeap, {a:g} V ({kind}): tilted past {hw.UPRIGHT_DEG:g} deg")
+        ax.axhline(0.0, color="0.6", lw=0.8)
+        ax.set_xlabel("stride frequency (Hz)")
+        ax.set_ylabel(f"forward speed ({unit})")
+    for p in PUBLISHED:
+        if p.get("frequency_hz") and "speed_m_s" in p:
+            axes[1].plot(p["frequency_hz"], p["speed_m_s"], "*", ms=14, color="k", label=f"{p['source']}: 0.5 m/s")
+            axes[0].plot(p["frequency_hz"], p["speed_m_s"] / p["frequency_hz"] * 1e3, "*", ms=14, color="k",
+                         label=f"{p['source']}: {p['speed_m_s'] / p['frequency_hz'] * 1e3:.2f} mm/cycle")
+        elif "mm_per_cycle" in p:
+            ax = axes[0]
+            ax.axhline(p["mm_per_cycle"], color="k", ls="--" if p["mm_per_cycle"] > 10 else ":", lw=1,
+                       label=f"{p['source']}: {p['mm_per_cycle']:.2f} mm/cycle (frequency not stated)")
+    axes[0].set_title("per cycle")
+    axes[1].set_title("per second")
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, fontsize=7, loc="lower center", ncol=2, bbox_to_anchor=(0.5, -0.02))
+    fig.suptitle("HAMR-VI open-loop trot: mjeap (hamr_walk, 0.3 s settling, 0.2 s measured) and the robot")
+    fig.tight_layout(rect=(0, 0.2, 1, 0.95))
+    with replacing(path, "--figure") as tmp:
+        fig.savefig(tmp, dpi=110, format="png")
+    plt.close(fig)
+
+
+def gait_main(argv=None):
+    """The gait study's command line (scripts/hamr_walk_gait.py): JSON of :func:`gait_study`
+    beside PUBLISHED, and its figure (:func:`gait_figure`)."""
+    import argparse
+    import json
+    import sys
+    from ...io.commandline import arg_number, arg_output, parse_args
+    from ...io.outputs import replacing, run_guard
+    ap = argparse.ArgumentParser(description="HAMR-VI's trot speed per frequency and amplitude beside the robot's")
+    ap.add_argument("--out", default="out/hamr_walk_gait.json", type=arg_output(), help="results (.json)")
+    ap.add_argument("--figure", default="out/hamr_walk_gait.png", type=arg_output(), help="figure (.png)")
+    ap.add_argument("--frequencies", nargs="+", type=arg_number(*model.FREQUENCY_RANGE, "Hz"),
+                    default=list(GAIT_FREQUENCIES), help="trot frequencies (Hz)")
+    ap.add_argument("--amplitudes", nargs="+", type=arg_number(0.0, hw.AMPLITUDE, "V"), default=list(GAIT_AMPLITUDES),
+                    help=f"drive amplitudes (V; {hw.AMPLITUDE:g}: full drive)")
+    ap.add_argument("--settle", type=arg_number(0.0, 10.0, "s"), default=0.3, help="settling before the window (s)")
+    ap.add_argument("--measure", type=arg_number(0.0, 10.0, "s", True), default=0.2, help="the window (s)")
+    ap.add_argument("--from-json", type=str, default=None,
+                    help="draw the figure from this JSON of an earlier run instead of simulating")
+    a = parse_args(ap, argv)
+    with run_guard(**{"--out": None if a.from_json else a.out, "--figure": a.figure}):
+        if a.from_json:
+            with open(a.from_json) as fh:
+                rows = json.load(fh)["runs"]
+        else:
+            rows = []
+
+            def write(row):
+                rows.append(row)
+                print(f"{row['frequency_hz']:g} Hz, {row['amplitude_v']:g} V: {row['speed_m_s']:.3f} m/s "
+                      f"({row['mm_per_cycle']:.2f} mm/cycle), upright {row['upright_whole_run']}", file=sys.stderr)
+                with replacing(a.out, "--out") as tmp:
+                    tmp.write_text(json.dumps({"runs": rows, "published": list(PUBLISHED)}, indent=1, default=float))
+            gait_study(a.frequencies, a.amplitudes, a.settle, a.measure, on_row=write)
+        try:
+            gait_figure(rows, a.figure)
+        except ImportError:
+            print("figure skipped: pip install -e '.[report]' for matplotlib", file=sys.stderr)
+    return 0
