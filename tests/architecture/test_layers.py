@@ -224,7 +224,7 @@ def test_the_graph_sees_the_layers():
     by rollouts, the floors come in their order, and they hold the modules they are meant to."""
     assert "mjeap.model.mjcf" in GRAPH["mjeap.simulation.scene"]
     assert "mjeap.simulation.scene" in GRAPH["mjeap.simulation.rollout"]
-    assert "mjeap.robots" in GRAPH["mjeap.cli"] and "mjeap.io.commandline" in GRAPH["mjeap.robots.hamr_leg.experiments"]
+    assert "mjeap.robots" in GRAPH["mjeap.cli.runs"] and "mjeap.io.commandline" in GRAPH["mjeap.robots.hamr_leg.experiments"]
     order = [layer(m) for m in ("mjeap.engines.loop", "mjeap.simulation.system", "mjeap.analysis.frequency",
                                 "mjeap.controllers.hamr_leg", "mjeap.studies.sweep.runner", "mjeap.robots.hamr_leg.model",
                                 "mjeap.envs.gymnasium_env", "mjeap.validation.core", "mjeap.cli", "mjeap")]

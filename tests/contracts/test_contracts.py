@@ -129,7 +129,7 @@ def test_a_design_beyond_the_point_limit_is_refused_before_it_is_built(monkeypat
     """--vary amplitude=0:1:1000000000 allocated until MemoryError: the count is refused
     from the spec's arithmetic, naming it and MAX_POINTS; a grid whose product is too large
     and a random design too."""
-    import mjeap.cli as cli
+    import mjeap.cli.studies as cli
     import mjeap.studies.sweep as sweep
     monkeypatch.setattr(cli.np, "linspace", _no_work)
     monkeypatch.setattr(sweep, "run_sweep", _no_work)

@@ -435,7 +435,7 @@ def test_mjeap_examples_copies_the_examples_and_never_a_changed_one(tmp_path, ca
     assert main(["examples", str(d)]) == 0
     files = sorted(str(p.relative_to(d)) for p in d.rglob("*") if p.is_file())
     assert files == sorted(str(p.relative_to(ROOT / "examples")) for p in (ROOT / "examples").rglob("*")
-                           if p.is_file() and p.suffix in (".py", ".toml") and "__pycache__" not in p.parts)
+                           if p.is_file() and p.suffix in (".py", ".toml", ".csv") and "__pycache__" not in p.parts)
     for f in files:                                        # every actuator file loads
         if f.endswith(".toml"):
             mjeap.get_actuator(str(d / f))
