@@ -125,7 +125,7 @@ def fit_tip_trajectory(scene, time, tip, voltage, drive=None, drive_params: Opti
     determine (relative 1-sigma above UNRESOLVED, or a factor e on it moving the trajectory
     by less than SENSITIVITY of its swing: the mass of a quasi-static record, the damping of
     one without ringing) is held at the file's and the reason noted."""
-    from .identify import _scene_like, check_series, covariance
+    from .identify import scene_like, check_series, covariance
     from ..simulation.rollout import rollout
     t, y = check_series(time, tip, names=["tip_deflection"])
     swing = float(np.ptp(y))
@@ -140,7 +140,7 @@ def fit_tip_trajectory(scene, time, tip, voltage, drive=None, drive_params: Opti
         v = dict(zip(names, np.exp(x)))
         variant = scaled_actuator(act, stiffness=v.get("stiffness", 1.0), mass=v.get("mass", 1.0),
                                   damping_ratio=v.get("damping_ratio", z0))
-        sc = _scene_like(scene, variant)
+        sc = scene_like(scene, variant)
         interval = max(sc.timestep, float(np.min(np.diff(t))) / 2)
         r = rollout(sc, voltage, duration + sc.timestep, drive=drive, drive_params=drive_params, progress=False,
                     sample_interval=interval)
@@ -191,7 +191,7 @@ def trajectory_actuator(scene, fit: ScaleFit, data: str, drive: Optional[str] = 
     ``data`` file, its 1-sigma and how; driven by ``drive`` (default its own) with ``given``
     over its parameters."""
     from ..drives import default_drive_name
-    from .identify import _noted, file_drive_rows
+    from .identify import noted, file_drive_rows
     act = scene.actuator
     how = f"identified from {data} (mjeap identify hinges: the tip trajectory fitted with the file's own model"
     infl = f", residual {fit.rms_residual:.3g} m rms; 1-sigma includes x {np.sqrt(fit.inflation):.3g} for its correlation)"
@@ -204,5 +204,5 @@ def trajectory_actuator(scene, fit: ScaleFit, data: str, drive: Optional[str] = 
     new = scaled_actuator(act, stiffness=fit.stiffness_scale, mass=fit.mass_scale,
                           damping_ratio=fit.damping_ratio if "damping_ratio" in fit.fitted else None, sources=src)
     drive = drive or default_drive_name(act)
-    return dataclasses.replace(new, drive=drive, notes=_noted(act, data, "hinges"),
+    return dataclasses.replace(new, drive=drive, notes=noted(act, data, "hinges"),
                                drive_parameters=file_drive_rows(act, drive, given or {}))

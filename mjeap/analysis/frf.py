@@ -25,7 +25,7 @@ refined on the model itself; the effective coupling is k_eff = sqrt(1 - (f_r / f
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Optional, Sequence, Union
+from typing import Optional
 
 import mujoco
 import numpy as np

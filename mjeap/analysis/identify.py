@@ -368,10 +368,10 @@ def step_actuator(act, fit: StepFit, data: str, given: Optional[Dict[str, tuple]
            f"rms residual {fit.rms_residual:.3g} 1/m)")
     fitted = {k: (float(v), "", how) for k, v in fit.drive_parameters().items()}
     rows = {**fitted, **{k: v for k, v in rows.items() if k not in fitted}}
-    return dataclasses.replace(act, drive=STEP_DRIVE, drive_parameters=rows, notes=_noted(act, data, "step"))
+    return dataclasses.replace(act, drive=STEP_DRIVE, drive_parameters=rows, notes=noted(act, data, "step"))
 
 
-def _noted(act, data: str, what: str) -> str:
+def noted(act, data: str, what: str) -> str:
     line = f"identified from {data} by mjeap identify {what}"
     return f"{act.notes}; {line}" if act.notes else line
 
@@ -393,7 +393,7 @@ def hinge_actuator(scene, fit: HingeFit, data: str, drive: Optional[str] = None,
     EI = Sourced(fit.stiffness * ds, "N m^2",
                  f"{how}, k = {fit.stiffness:.4g} +- {fit.stiffness_std:.2g} N m/rad at every hinge; EI = k L/N, "
                  "uniform along the beam)")
-    new = dataclasses.replace(act, flexural_rigidity=EI, drive=drive, notes=_noted(act, data, "hinges"),
+    new = dataclasses.replace(act, flexural_rigidity=EI, drive=drive, notes=noted(act, data, "hinges"),
                               drive_parameters=file_drive_rows(act, drive, given or {}))
     beta = fit.damping / fit.stiffness + scene.choice.integrator_beta
     zeta = beta / _beta_per_damping_ratio(scene, new)
@@ -409,7 +409,7 @@ def hinge_actuator(scene, fit: HingeFit, data: str, drive: Optional[str] = None,
                    f"{scene.integrator}))"))
 
 
-def _scene_like(scene, act, **kw):
+def scene_like(scene, act, **kw):
     """A Scene of ``act`` built as ``scene`` is (representation, segments, orientation,
     payload, units, gravity, integrator), ``kw`` over it."""
     from ..simulation.scene import Scene
@@ -422,7 +422,7 @@ def _scene_like(scene, act, **kw):
 def _beta_per_damping_ratio(scene, act) -> float:
     """The Rayleigh beta (s) per unit first-mode damping ratio of ``act`` built as ``scene``
     (beta = 2 zeta w1 / k1 is linear in zeta: the probe is built at zeta = 1)."""
-    return _scene_like(scene, act, damping_ratio=1.0).choice.rayleigh_beta
+    return scene_like(scene, act, damping_ratio=1.0).choice.rayleigh_beta
 
 
 def reproduction_error(scene, fit: HingeFit, act, time, voltage, drive=None, drive_params=None) -> Tuple[float, float]:
@@ -434,6 +434,6 @@ def reproduction_error(scene, fit: HingeFit, act, time, voltage, drive=None, dri
     t = np.asarray(time, float)
     duration = float(t[-1]) + scene.timestep
     fitted = simulate_tip(scene, fit.stiffness, fit.damping, voltage, duration, t, drive, drive_params)
-    r = rollout(_scene_like(scene, act), voltage, duration, progress=False)
+    r = rollout(scene_like(scene, act), voltage, duration, progress=False)
     mine = np.interp(t, r.time, r.tip_position[:, 1])
     return float(np.sqrt(np.mean((mine - fitted) ** 2))), float(np.ptp(fitted))

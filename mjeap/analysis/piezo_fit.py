@@ -116,7 +116,7 @@ def read_impedance(path) -> Tuple[np.ndarray, np.ndarray, object]:
         g = 1.0 / d["resistance"] if res else 0.0
         return d["frequency"], g + 2j * np.pi * d["frequency"] * d["capacitance"], True if res else "susceptance"
     raise ParameterError("impedance file", str(path), "columns frequency and admittance (S), impedance (ohm) or "
-                         f"capacitance (F) (each with its unit in the header)", f"it has {', '.join(names)}")
+                         "capacitance (F) (each with its unit in the header)", f"it has {', '.join(names)}")
 
 
 # ---------------------------------------------------------------- the model
@@ -125,7 +125,7 @@ class _Model:
 
     def __init__(self, scene, drive_params: Optional[dict] = None):
         from .frf import SmallSignalModel
-        from .identify import _scene_like
+        from .identify import scene_like
         self.scene = scene
         self.base = SmallSignalModel(scene, drive_params=drive_params)
         if self.base.drive.name not in COUPLING_PARAMETER:
@@ -137,7 +137,7 @@ class _Model:
         if self.block > 0:          # the mass and gravity matrices are linear in the block's mass
             twice = dataclasses.replace(act, planform=dataclasses.replace(
                 act.planform, residual_tip_mass=act.planform.residual_tip_mass + self.block))
-            lin2 = _scene_like(scene, twice).linearization
+            lin2 = scene_like(scene, twice).linearization
             self.dM, self.dKg = lin2.M - self.M0, lin2.K_gravity - self.Kg0
         else:
             self.dM = self.dKg = np.zeros_like(self.M0)
@@ -360,8 +360,7 @@ def piezo_actuator(scene, fit: PiezoFit, data: PiezoData, given: Optional[Dict[s
     measurement(s) it came from, its 1-sigma and how; ``given`` drive parameters over the
     file's."""
     from .file_fit import scaled_actuator
-    from .identify import _noted, file_drive_rows
-    from ..model.actuator import Sourced
+    from .identify import noted, file_drive_rows
     act = scene.actuator
     drive = act.drive or _drive_name(act)
     rows = file_drive_rows(act, drive, given or {})
@@ -397,7 +396,7 @@ def piezo_actuator(scene, fit: PiezoFit, data: PiezoData, given: Optional[Dict[s
             if old is None:     # the laminate's own: its dielectric term (capacitance), no leakage (resistance)
                 old = _laminate_default(scene, key)
             rows[key] = (float(old * f(v[p])), "", f"{how(p)}: x {f(v[p]):.6g} of {old:.6g}")
-    new = dataclasses.replace(new, drive=drive, drive_parameters=rows, notes=_noted(act, used, "piezo"))
+    new = dataclasses.replace(new, drive=drive, drive_parameters=rows, notes=noted(act, used, "piezo"))
     return new
 
 

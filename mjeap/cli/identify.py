@@ -129,8 +129,8 @@ def _identify_hinges(args, stack) -> int:
 
 def file_fit_f1(scene, act) -> float:
     """The first mode (Hz) of ``act`` built as ``scene`` is."""
-    from ..analysis.identify import _scene_like
-    return float(_scene_like(scene, act).choice.first_frequency)
+    from ..analysis.identify import scene_like
+    return float(scene_like(scene, act).choice.first_frequency)
 
 
 def cmd_identify_piezo(args) -> int:

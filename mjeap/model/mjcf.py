@@ -174,7 +174,7 @@ class BeamBuilder:
         raise NotImplementedError
 
 
-def _finder(model, prefix, find):
+def element_finder(model, prefix, find):
     if find is not None:
         return find
 
@@ -192,7 +192,7 @@ def _mat2quat(R: np.ndarray) -> np.ndarray:
     return q
 
 
-def _set_inertial(body, mass, com_local, inertia, units: UnitSystem):
+def set_inertial(body, mass, com_local, inertia, units: UnitSystem):
     body.explicitinertial = True
     body.mass = mass / units.mass
     body.ipos = np.asarray(com_local, dtype=float) / units.length
@@ -212,7 +212,7 @@ class HingeChainBuilder(BeamBuilder):
 
     def view(self, model, handles, layout, units, prefix="", find=None):
         from .views import HingeView
-        look = _finder(model, prefix, find)
+        look = element_finder(model, prefix, find)
         return HingeView(model, np.array([look(mujoco.mjtObj.mjOBJ_JOINT, n) for n in handles.joints], dtype=int))
 
     def build(self, spec, layout, units):
@@ -230,7 +230,7 @@ class HingeChainBuilder(BeamBuilder):
             b.add_geom(name=f"link{j}", type=mujoco.mjtGeom.mjGEOM_BOX,
                        size=[half, 0.5 * t, 0.5 * layout.link_width[j] / units.length],
                        pos=[half, 0, 0], rgba=BEAM_RGBA, contype=0, conaffinity=0)
-            _set_inertial(b, layout.link_mass[j], [layout.link_com[j] - x0, 0, 0],
+            set_inertial(b, layout.link_mass[j], [layout.link_com[j] - x0, 0, 0],
                           layout.link_inertia[j], units)
             bodies.append(b.name)
             joints.append(f"hinge{j}")
@@ -267,7 +267,7 @@ class CableBuilder(BeamBuilder):
 
     def view(self, model, handles, layout, units, prefix="", find=None):
         from .views import CableView
-        look = _finder(model, prefix, find)
+        look = element_finder(model, prefix, find)
         return CableView(model, np.array([look(mujoco.mjtObj.mjOBJ_JOINT, n) for n in handles.joints], dtype=int))
 
     def extensions_xml(self) -> str:
@@ -309,7 +309,7 @@ class CableBuilder(BeamBuilder):
             w_eq = 12 * layout.hinge_stiffness[j] * layout.ds / (E * t**3)
             g = b.geoms[0]
             g.size = [g.size[0], 0.5 * t / units.length, 0.5 * w_eq / units.length]
-            _set_inertial(b, layout.link_mass[j], [layout.link_com[j] - layout.link_start[j], 0, 0],
+            set_inertial(b, layout.link_mass[j], [layout.link_com[j] - layout.link_start[j], 0, 0],
                           layout.link_inertia[j], units)
         spec.body(f"{self.prefix}B_first").geoms[0].mass = 0.0
         joints = [spec.body(n).joints[0].name for n in names]
@@ -446,7 +446,7 @@ def build_spec(layout: BeamLayout, representation: str = "hinge", orientation: s
     tip = spec.body(handles.tip_body)
     tip_local = (layout.tip_x - layout.link_start[-1]) / units.length
     tip.add_site(name="tip", pos=[tip_local, 0, 0], size=[0.01 * L, 0, 0], rgba=[1, 0.3, 0.1, 1])
-    _set_inertial(tip.add_body(name=handles.tip_load_body, pos=[tip_local, 0, 0]), 0.0, [0, 0, 0], [0, 0, 0], units)
+    set_inertial(tip.add_body(name=handles.tip_load_body, pos=[tip_local, 0, 0]), 0.0, [0, 0, 0], [0, 0, 0], units)
     if layout.extension_length > 0:
         x0 = (layout.length - layout.link_start[-1]) / units.length
         ext = tip.add_body(name="extension", pos=[x0, 0, 0])
@@ -454,7 +454,7 @@ def build_spec(layout: BeamLayout, representation: str = "hinge", orientation: s
         ext.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=[half, 0.5 * t, 0.5 * layout.link_width[-1] / units.length],
                      pos=[half, 0, 0], rgba=[0.9, 0.9, 0.85, 1], contype=0, conaffinity=0)
         m = max(layout.extension_mass, 1e-6 * layout.link_mass[-1])
-        _set_inertial(ext, m, [layout.extension_length / 2, 0, 0],
+        set_inertial(ext, m, [layout.extension_length / 2, 0, 0],
                       block_inertia(m, layout.extension_length, layout.thickness, layout.link_width[-1]), units)
     if payload is not None:
         j = layout.link_containing(min(payload.position, layout.length))
@@ -463,6 +463,6 @@ def build_spec(layout: BeamLayout, representation: str = "hinge", orientation: s
         pb = host.add_body(name="payload", pos=[(payload.position - layout.link_start[j]) / units.length, 0, 0])
         pb.add_geom(name="payload", type=mujoco.mjtGeom.mjGEOM_SPHERE, size=[r / units.length, 0, 0],
                     rgba=[0.75, 0.2, 0.2, 1], contype=0, conaffinity=0)
-        _set_inertial(pb, payload.mass, [0, 0, 0], [payload.inertia] * 3, units)
+        set_inertial(pb, payload.mass, [0, 0, 0], [payload.inertia] * 3, units)
         handles.payload_body = "payload"
     return spec, handles

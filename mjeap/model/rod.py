@@ -99,7 +99,7 @@ from ..errors import ParameterError
 from ..units import UnitSystem
 from .discretize import BeamLayout
 from .mjcf import (ATTACHED_WHOLE, BEAM_RGBA, FIXED_BENDING_FORCES, HINGE_CHAIN_ERROR, HINGE_TENDON, BeamBuilder,
-                   BeamHandles, _finder, _set_inertial, register)
+                   BeamHandles, element_finder, set_inertial, register)
 from .views import BeamView, into
 
 #: impedance of the rod's edge constraints: 1 - d = 1e-4 of the violation's restoring
@@ -201,7 +201,7 @@ class RodBuilder(BeamBuilder):
         # vertex N + 1 and the last link
         tip = spec.body(f"{n}_{N}").add_body(name=f"{n}_tip")
         tip.add_joint(name=f"{n}_tip", type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 0, 1])
-        _set_inertial(tip, layout.link_mass[-1], [layout.link_com[-1] - layout.link_start[-1], 0, 0],
+        set_inertial(tip, layout.link_mass[-1], [layout.link_com[-1] - layout.link_start[-1], 0, 0],
                       layout.link_inertia[-1], units)
         flex = spec.flex(n)
         vb = list(flex.vertbody)
@@ -280,7 +280,7 @@ class RodBuilder(BeamBuilder):
         return Linearization(M, Ke, Kg, Ke.copy())
 
     def view(self, model, handles, layout, units, prefix="", find=None):
-        return RodView(model, handles, layout, units, prefix, _finder(model, prefix, find), self.name)
+        return RodView(model, handles, layout, units, prefix, element_finder(model, prefix, find), self.name)
 
 
 class RodView(BeamView):

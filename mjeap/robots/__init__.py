@@ -21,7 +21,7 @@ import importlib
 from typing import Dict, List, Optional
 
 from ..errors import ParameterError, UnknownNameError
-from .registry import _REGISTRY, Robot, register, summary
+from .registry import REGISTRY, Robot, register, summary
 
 #: the packages that register the robots, imported on first use (they import SciPy and MjSpec code)
 _MODULES = ("gripper", "hamr_leg", "hamr_walk", "robobee_wing")
@@ -32,7 +32,7 @@ __all__ = ["Robot", "register", "names", "get", "load", "summary"]
 def _loaded() -> Dict[str, Robot]:
     for m in _MODULES:
         importlib.import_module(f"{__name__}.{m}")
-    return _REGISTRY
+    return REGISTRY
 
 
 def names(tag: Optional[str] = None) -> List[str]:

@@ -23,7 +23,7 @@ class Robot:
     tags: Tuple[str, ...] = ()
 
 
-_REGISTRY: Dict[str, Robot] = {}
+REGISTRY: Dict[str, Robot] = {}
 
 
 def summary(doc: str) -> str:
@@ -52,8 +52,8 @@ def register(robot: Robot, *, replace: bool = False) -> Robot:
     """Add ``robot`` to the registry (a module calls this once, at import; the same module
     registering again, re-imported or reloaded, replaces its entry). Its name: letters,
     digits, '-' and '_'; a name taken is refused unless ``replace``."""
-    check_registration("robot", _REGISTRY, getattr(robot, "name", None), robot, lacks=_robot_lacks(robot),
+    check_registration("robot", REGISTRY, getattr(robot, "name", None), robot, lacks=_robot_lacks(robot),
                        expected="a mjeap.robots.Robot with a name, a build and a main", replace=replace,
                        how="mjeap.robots.register", origin=lambda r: plugin_origin(r.build))
-    _REGISTRY[robot.name] = robot
+    REGISTRY[robot.name] = robot
     return robot

@@ -477,8 +477,8 @@ def optimize(actuator, vary: Mapping[str, object], maximize: Optional[str] = Non
     from ..io.outputs import check_outputs, hold, replacing
     from ..model.actuator_file import actuator_toml, is_actuator_file
     from .sweep import METRICS, STATIC_METRICS, check_metric_settings, check_settings
-    from .sweep.points import _check_names
-    from .sweep.runner import _drop_torn_row, _read_sweep_csv, _RowFile
+    from .sweep.points import check_names
+    from .store import RowFile, drop_torn_row, read_study_csv
 
     t0 = time.perf_counter()
     # ---- the question, checked before any work
@@ -540,7 +540,7 @@ def optimize(actuator, vary: Mapping[str, object], maximize: Optional[str] = Non
         fixed = dict(base or {})
         if "actuator" in fixed:
             raise ParameterError("base", "actuator", "the actuator as optimize's first argument, not in base/--set")
-        _check_names(fixed)
+        check_names(fixed)
         fixed["actuator"] = base_name
         act0 = variants.get_base(base_name)
         names = sorted(vary)
@@ -575,15 +575,15 @@ def optimize(actuator, vary: Mapping[str, object], maximize: Optional[str] = Non
                             active, base_name, t0, files, act0, de_tol, front, pareto_points, slice_points)
             csv_path = files["evaluations"]
             with hold(csv_path, "--out (evaluations.csv)", holder="mjeap optimize", picked=True):
-                _drop_torn_row(csv_path)
+                drop_torn_row(csv_path)
                 cached, delimiter = {}, ","
                 if csv_path.exists() and csv_path.stat().st_size > 0:
-                    header, rows, delimiter = _read_sweep_csv(csv_path)
+                    header, rows, delimiter = read_study_csv(csv_path)
                     if header != columns:
                         raise ParameterError("--out", str(csv_path), f"the evaluations of this optimisation (columns "
                                              f"{columns}); it has {header}: choose another --out")
                     cached = {r["point_id"]: r for r in rows}
-                writer = _RowFile(csv_path, delimiter, "--out (evaluations.csv)")
+                writer = RowFile(csv_path, delimiter, "--out (evaluations.csv)")
                 try:
                     if not cached:
                         writer.write(columns, 0)

@@ -122,3 +122,17 @@ def test_the_check_finds_a_crossing(tmp_path):
                  "    getattr(self, '_mine')\n    return part._theirs, getattr(p, '_hidden', 0), p.__dict__['_x']\n")
     assert sorted(t for _, t in crossings(f)) == ["getattr(p, '_hidden', 0)", "p.__dict__['_x']", "part._theirs",
                                                   "scene._step_count"]
+
+
+def test_no_module_imports_another_modules_private_name():
+    """``from .x import _name`` reaches into another module as an attribute access does
+    (issue 44: rod.py took mjcf's helpers, the optimiser the sweep's CSV store): what modules
+    share is public in the module that defines it."""
+    import ast as _ast
+    found = []
+    for p in sorted((ROOT / "mjeap").rglob("*.py")):
+        for node in _ast.walk(_ast.parse(p.read_text())):
+            if isinstance(node, _ast.ImportFrom) and node.level:
+                found += [f"{p.relative_to(ROOT)}:{node.lineno} {a.name}" for a in node.names
+                          if a.name.startswith("_") and not a.name.startswith("__")]
+    assert not found, found

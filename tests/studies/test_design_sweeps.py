@@ -163,7 +163,7 @@ def test_energy_per_cycle_is_what_the_dampers_and_the_resistance_dissipate(bimor
     the dissipated power over 10 periods, against the metric's fit to the last period)."""
     base = {"actuator": bimorph, "segments": 10, "orientation": "down"}
     p = {**sweep.PARAMETERS, **base, "actuator.length": 0.010}
-    scene = sweep._scene(p)
+    scene = sweep.point_scene(p)
     dt, f1 = scene.timestep, scene.choice.first_frequency
     n = int(round(1 / (ratio * f1 * dt))) + fraction       # steps a period
     f = 1 / (n * dt)
@@ -171,8 +171,8 @@ def test_energy_per_cycle_is_what_the_dampers_and_the_resistance_dissipate(bimor
     wave = {"waveform": "sine", "amplitude": 20.0, "offset": 100.0, "frequency": f, "duration": duration}
     row = sweep.evaluate({"actuator.length": 0.010}, ("energy_per_cycle", "peak_power"), {**base, **wave})
     assert row["error"] == ""
-    s = sweep._scene({**p, **wave})
-    r = rollout(s, sweep._wave_text({**p, **wave}), duration, sample_interval=dt, progress=False)
+    s = sweep.point_scene({**p, **wave})
+    r = rollout(s, sweep.wave_text({**p, **wave}), duration, sample_interval=dt, progress=False)
     d = np.diff(r.centreline[:, :, :2], axis=1)               # clamp, link origins, tip: segment directions
     theta = np.diff(np.arctan2(d[..., 1], d[..., 0]), axis=1)   # the hinges' angles
     assert np.allclose(theta[-1], s.hinge_angles(), atol=1e-12)

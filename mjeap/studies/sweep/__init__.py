@@ -23,12 +23,13 @@ their parameters, designs, keys and the checks before any point runs),
 """
 from .points import (MAX_POINTS, PARAMETERS, SWEEP_WAVEFORMS, check_design_size, check_settings, grid, point_id,
                      random_design, settings)
-from .points import _scene, _wave_text  # noqa: F401  (a point's Scene and waveform text, as the runner makes them)
+from .points import point_scene, wave_text  # a point's Scene and waveform text, as the runner makes them
 from .metrics import (END_METRICS, METRIC_UNITS, METRICS, OWN_SCENE_METRICS, STATIC_METRICS, STEP_METRICS,
                       check_metric_settings, metric_value, register_metric)
 from .runner import (EXECUTORS, SweepSummary, evaluate, read_results, run_sweep, stop_workers, worker_signals)
 
-__all__ = ["EXECUTORS", "MAX_POINTS", "PARAMETERS", "SWEEP_WAVEFORMS", "METRICS", "METRIC_UNITS", "STATIC_METRICS",
+__all__ = ["point_scene", "wave_text", "EXECUTORS", "MAX_POINTS", "PARAMETERS", "SWEEP_WAVEFORMS", "METRICS",
+           "METRIC_UNITS", "STATIC_METRICS",
            "END_METRICS", "STEP_METRICS", "OWN_SCENE_METRICS", "SweepSummary", "check_design_size",
            "check_metric_settings", "check_settings", "evaluate", "grid", "metric_value", "point_id",
            "random_design", "read_results", "register_metric", "run_sweep", "settings", "stop_workers",

@@ -168,11 +168,11 @@ def _voltage_extremes(point) -> np.ndarray:
     amplitude; a periodic waveform's offset -/+ amplitude where the run lasts a period, else
     the waveform sampled finely over the run."""
     from ...drives.waveforms import parse_waveform
-    from .points import _duration, _wave_text
-    wave = parse_waveform(_wave_text(point))
+    from .points import point_duration, wave_text
+    wave = parse_waveform(wave_text(point))
     if wave.kind == "step":
         return np.array([wave.amplitude])
-    duration = _duration(point)
+    duration = point_duration(point)
     if duration * wave.frequency >= 1.0:
         return wave.offset + np.array([-1.0, 1.0]) * abs(wave.amplitude)
     v = wave(np.linspace(0.0, duration, 20001))

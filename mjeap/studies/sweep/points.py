@@ -38,7 +38,7 @@ PARAMETERS: Dict[str, object] = {
 }
 
 
-def _check_names(names: Iterable[str]) -> None:
+def check_names(names: Iterable[str]) -> None:
     for n in names:
         if n not in PARAMETERS and not n.startswith("drive.") and not n.startswith("actuator."):
             raise ParameterError("sweep parameter", n, f"one of {', '.join(PARAMETERS)}, drive.NAME or actuator.NAME "
@@ -57,7 +57,7 @@ def check_design_size(count: int, name: str = "design", how: str = "") -> int:
 def grid(**values: Sequence) -> List[dict]:
     """Full factorial design: every combination of the given values (at most MAX_POINTS,
     refused before the combinations are built)."""
-    _check_names(values)
+    check_names(values)
     names = list(values)
     lists = [list(values[n]) for n in names]
     check_design_size(math.prod(map(len, lists)), "grid", " x ".join(f"{n}: {len(v)}" for n, v in zip(names, lists)))
@@ -67,7 +67,7 @@ def grid(**values: Sequence) -> List[dict]:
 def random_design(n: int, seed: int = 0, **ranges) -> List[dict]:
     """``n`` points, each parameter drawn uniformly from a (low, high) range or a list of
     choices, with numpy's generator seeded by ``seed``."""
-    _check_names(ranges)
+    check_names(ranges)
     if int(n) < 1:
         raise ParameterError("n", n, "a positive number of points")
     check_design_size(int(n), "n", "random points")
@@ -205,7 +205,7 @@ def _check_fixed(points: Sequence[dict], base: dict) -> None:
             if points and not any("duration" in p for p in points) and \
                     {**PARAMETERS, **base, **points[0]}["accuracy"] in (None, ""):
                 try:
-                    scene = _scene({**PARAMETERS, **base, **points[0]})
+                    scene = point_scene({**PARAMETERS, **base, **points[0]})
                 except MjeapError:
                     scene = None               # the point reports its own scene's error
                 if scene is not None:
@@ -227,13 +227,13 @@ SCENE_PARAMETERS = ("actuator", "representation", "segments", "orientation", "pa
 
 def scene_key(p: dict) -> str:
     """What a point's scene is built from (its full parameters ``p``), as text: points with
-    the same key share a scene (:func:`_scene`)."""
+    the same key share a scene (:func:`point_scene`)."""
     from ...model.variants import is_design_parameter
     return json.dumps({k: v for k, v in p.items() if k in SCENE_PARAMETERS or is_design_parameter(k)},
                       sort_keys=True, default=str)
 
 
-def _scene(p: dict):
+def point_scene(p: dict):
     """The Scene of a point's full parameters (``base`` and the defaults filled in), shared
     with the earlier points of the same scene in this thread (:meth:`Scene.shared`)."""
     from ...model.discretize import Payload
@@ -253,14 +253,14 @@ def _scene(p: dict):
                         accuracy=None if p["accuracy"] in (None, "") else float(p["accuracy"]))
 
 
-def _wave_text(p: dict) -> str:
+def wave_text(p: dict) -> str:
     """The waveform text of a point's parameters (mjeap.drives.waveforms)."""
     f, a = float(p["frequency"]), float(p["amplitude"])
     return f"step:{a!r}V" if p["waveform"] == "step" else \
         f"{p['waveform']}:{a!r}V@{f!r}Hz,offset={float(p['offset'])!r}V"
 
 
-def _duration(p: dict) -> float:
+def point_duration(p: dict) -> float:
     """A point's duration (s): its own, else two drive periods."""
     return float(p["duration"]) if p["duration"] not in (None, "") else 2.0 / float(p["frequency"])
 
@@ -269,5 +269,5 @@ def _check_stop(p: dict) -> None:
     """A point's periodic stop, as its rollout will check it (mjeap.simulation.rollout.check_stop)."""
     from ...drives.waveforms import parse_waveform
     from ...simulation.rollout import check_stop
-    check_stop(float(p["stop_when_periodic"]), parse_waveform(_wave_text(p)), _duration(p),
+    check_stop(float(p["stop_when_periodic"]), parse_waveform(wave_text(p)), point_duration(p),
                at_accuracy=p["accuracy"] not in (None, ""))

@@ -14,10 +14,8 @@ same code runs on all three; Dask is the optional ``sweep`` extra.
 """
 from __future__ import annotations
 
-import io
 import json
 import os
-import stat
 import sys
 import time
 import traceback
@@ -29,13 +27,12 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import List, Optional, Sequence
 
-from ...io import csvio
-from ...errors import (DivergenceError, MjeapError, OutputError, ParameterError, UnknownNameError, check_integer,
-                      sigterm_as_interrupt)
-from ...io.outputs import appending, check_outputs, hold, output_kind
+from ...errors import (DivergenceError, MjeapError, ParameterError, UnknownNameError, check_integer, sigterm_as_interrupt)
+from ...io.outputs import check_outputs, hold, output_kind
+from ..store import RowFile, drop_torn_row, read_study_csv
 from ...model.laminate import FieldWarning
 from . import metrics as _metrics      # its registries, read where a point runs
-from .points import (PARAMETERS, _check_names, _duration, _scene, _wave_text, check_design_size, check_settings,
+from .points import (PARAMETERS, check_names, point_duration, point_scene, wave_text, check_design_size, check_settings,
                      point_id, settings)
 from .metrics import check_metric_settings, metric_value
 
@@ -75,7 +72,7 @@ def _evaluate_into(row: dict, p: dict, metrics: Sequence[str], rrd_dir, error_mo
     unknown = [m for m in metrics if m not in _metrics.METRICS]
     if unknown:
         raise UnknownNameError("metric", unknown[0], _metrics.METRICS)
-    scene = _scene(p)
+    scene = point_scene(p)
     for m in metrics:                   # the scene's own metrics first: no rollout for them
         if m in _metrics.STATIC_METRICS:
             row[m] = metric_value(m, _metrics.METRICS[m](None, p, scene))
@@ -95,8 +92,8 @@ def _run_point(p: dict, scene, metrics: Sequence[str], rrd_dir, pid: str, error_
     MAX_STEP_SAMPLES) for STEP_METRICS, sparsely where every metric reads only the run's end
     (END_METRICS: the scene holds the end), else the rollout's default."""
     from ...simulation.rollout import rollout
-    wave = _wave_text(p)
-    duration = _duration(p)
+    wave = wave_text(p)
+    duration = point_duration(p)
     drive_params = {k[6:]: v for k, v in p.items() if k.startswith("drive.")}
     rrd = None if rrd_dir is None else Path(rrd_dir) / f"point-{pid}.rrd"
     stop = None if p["stop_when_periodic"] in (None, "") else float(p["stop_when_periodic"])
@@ -141,37 +138,6 @@ class SweepSummary:
         return self.done / self.wall_s if self.wall_s > 0 else float("nan")
 
 
-def _drop_torn_row(path: Path) -> None:
-    """A file cut mid-line (a killed writer) loses its partial last row, which would
-    otherwise count as done and have the next row glued onto it; the point runs again."""
-    if not path.exists() or path.stat().st_size == 0:
-        return
-    with open(path, "rb+") as fh:
-        data = fh.read()
-        if data.endswith(b"\n"):
-            return
-        cut = data.rfind(b"\n") + 1
-        fh.truncate(cut)
-    warnings.warn(f"{path}: dropped a partial last row ({len(data) - cut} bytes, cut mid-line); its point runs again",
-                  stacklevel=3)
-
-
-def _read_sweep_csv(path):
-    """A sweep's CSV read as :mod:`mjeap.io.csvio` reads users' files (a UTF-8 BOM, ',', ';'
-    or tab as the delimiter: a file re-saved by a spreadsheet): (header, rows as dicts,
-    delimiter). Refused, naming the file, where its first row does not name ``point_id`` (the
-    header was lost or replaced: the points done could not be told)."""
-    rows, delimiter = csvio.read_table(path, "path")
-    header = rows[0]
-    if "point_id" not in header:
-        shown = ", ".join(header[:3]) + (", ..." if len(header) > 3 else "")
-        raise ParameterError("path", str(path), "a sweep CSV whose first row is the header mjeap wrote, naming "
-                             "point_id (the key of each point done)", f"its first row is [{shown}]: the header row "
-                             "was lost or changed (re-saved by a spreadsheet?); restore it, or start a new file")
-    pad = [""] * len(header)
-    return header, [dict(zip(header, r + pad[len(r):])) for r in rows[1:]], delimiter
-
-
 def read_results(path) -> List[dict]:
     """Rows of a sweep CSV (strings, as given: the quote that keeps a spreadsheet from
     running a text cell as a formula is dropped; a BOM, ';' or tab delimiters of a file
@@ -179,7 +145,7 @@ def read_results(path) -> List[dict]:
     and must name ``point_id``, else a ParameterError names the file)."""
     if Path(path).is_file() and Path(path).stat().st_size == 0:
         return []
-    return _read_sweep_csv(path)[1]
+    return read_study_csv(path)[1]
 
 
 def _die_with_parent() -> None:
@@ -475,7 +441,7 @@ def run_sweep(points: Sequence[dict], path, metrics: Sequence[str] = ("peak_to_p
     points = list(points)
     check_design_size(len(points), "points")
     for p in points:
-        _check_names(p)
+        check_names(p)
     if isinstance(record, (str, bytes, int)):
         raise ParameterError("record", record, "a list of point indices, e.g. [0, 5]")
     n = len(points)
@@ -510,10 +476,10 @@ def sweep_inputs(points: Sequence[dict], base: Optional[dict] = None) -> list:
 def _run_locked(points, path, metrics, base, executor, workers, scheduler, record, rrd_dir, progress, share=True):
     stream = output_kind(path) == "stream"             # /dev/stdout, a FIFO: written through, never read back
     if not stream:
-        _drop_torn_row(path)
+        drop_torn_row(path)
     done_ids, header, delimiter = set(), None, ","
     if not stream and path.exists() and path.stat().st_size > 0:   # resumed: read as users' CSVs are, appended in its form
-        header, rows, delimiter = _read_sweep_csv(path)
+        header, rows, delimiter = read_study_csv(path)
         done_ids = {row["point_id"] for row in rows}
     rrd_dir = str(rrd_dir or path.parent / (path.stem + "-rrd"))
     record = set(int(i) for i in record)
@@ -539,44 +505,10 @@ def _run_locked(points, path, metrics, base, executor, workers, scheduler, recor
                            delimiter)
 
 
-class _RowFile:
-    """The sweep's CSV, appended one whole row at a time: a row is formatted first, then
-    written and fsynced; a write that fails (a full disk) cuts the file back to its last
-    whole row and raises :class:`OutputError` saying how many rows are kept, so that a rerun
-    resumes from them (a stream, e.g. /dev/stdout, is written through)."""
-
-    def __init__(self, path: Path, delimiter: str = ",", name: str = "path"):
-        self.path = path
-        self.fd = appending(path, name)               # never through a link (mjeap.io.outputs)
-        self.regular = stat.S_ISREG(os.fstat(self.fd).st_mode)
-        self.buf = io.StringIO()
-        self.writer = csvio.writer(self.buf, delimiter=delimiter)
-
-    def write(self, cells, kept: int) -> None:
-        self.buf.seek(0)
-        self.buf.truncate()
-        self.writer.writerow(cells)
-        data = memoryview(self.buf.getvalue().encode("utf-8"))
-        end = os.lseek(self.fd, 0, os.SEEK_END) if self.regular else None
-        try:
-            while data:
-                data = data[os.write(self.fd, data):]
-            if self.regular:
-                os.fsync(self.fd)
-        except OSError as e:
-            if self.regular:
-                os.ftruncate(self.fd, end)
-            raise OutputError([(str(self.path), f"{e.strerror or e}; the {kept} whole rows written so far are "
-                                               "kept: rerun the same sweep to resume from them")]) from None
-
-    def close(self) -> None:
-        os.close(self.fd)
-
-
 def _write_rows(path, columns, new_file, executor, workers, scheduler, jobs, bar, skipped, t0, share=True,
                 delimiter=","):
     failed, done = 0, 0
-    out = _RowFile(path, delimiter)
+    out = RowFile(path, delimiter)
     try:
         if new_file:
             out.write(columns, 0)
