@@ -45,78 +45,30 @@ from __future__ import annotations
 import dataclasses
 import json
 import math
-import re
 import sys
 import tempfile
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Dict, List, Mapping, Optional, Sequence, Tuple, Union
+from typing import Dict, List, Mapping, Optional, Sequence, Tuple
 
 import numpy as np
 
-from .parameters import to_value
+from .constraints import Constraint, parse_constraint
+from .optimize_figures import draw, write_front
+from .parameters import VARIABLE, to_value
+from .search import Box, Evaluations, Goal, SearchSettings, clean, number, search, sensitivities, slices, trace_front
 from ..errors import MjeapError, ParameterError, UnknownNameError, check_integer, check_range, sigterm_as_interrupt
 
 __all__ = ["optimize", "Constraint", "OptimizeResult", "parse_constraint", "parse_bounds", "METHODS"]
 
 METHODS = ("slsqp", "differential-evolution")
-#: sweep parameters an optimisation may vary besides actuator.X and drive.NAME: (unit, low, high,
-#: low open) - the range a bound must lie in
-VARIABLE = {"payload_mass": ("kg", 0.0, math.inf, False), "payload_position": ("m", 0.0, math.inf, True),
-            "amplitude": ("V", -math.inf, math.inf, False), "offset": ("V", -math.inf, math.inf, False),
-            "frequency": ("Hz", 0.0, math.inf, True), "initial_curvature": ("1/m", -math.inf, math.inf, False),
-            "damping_ratio": ("-", 0.0, 10.0, True)}
 #: the files an optimisation writes in its folder
 RESULT, EVALUATIONS, OPTIMUM = "result.json", "evaluations.csv", "optimum.toml"
 FIGURE, PARETO, PARETO_FIGURE = "optimize.png", "pareto.csv", "pareto.png"
 #: the actuator file of an optimisation that found no feasible point: its least infeasible point,
 #: never named optimum; BASE: an Actuator object given as the base, written for the evaluations
 LEAST_INFEASIBLE, BASE = "least-infeasible.toml", "base.toml"
-_CONSTRAINT = re.compile(r"^\s*([A-Za-z0-9_-]+)\s*(>=|<=)\s*(.+?)\s*$")
-
-
-@dataclass(frozen=True)
-class Constraint:
-    """``metric >= bound`` or ``metric <= bound`` (SI)."""
-
-    metric: str
-    sense: str
-    bound: float
-
-    @property
-    def expression(self) -> str:
-        return f"{self.metric}{self.sense}{self.bound:g}"
-
-    def margin(self, value: float) -> float:
-        """How far ``value`` lies on the feasible side, relative to the bound (>= 0: met)."""
-        scale = abs(self.bound) if self.bound != 0 else 1.0
-        return (value - self.bound) / scale if self.sense == ">=" else (self.bound - value) / scale
-
-
-def parse_constraint(text: Union[str, Constraint, tuple]) -> Constraint:
-    """``"NAME>=VALUE"`` or ``"NAME<=VALUE"`` (VALUE SI or with the metric's unit, e.g.
-    ``first_frequency>=0.8kHz``), a (name, sense, value) tuple or a Constraint."""
-    from ..model.quantity import to_si
-    from .sweep import METRIC_UNITS, METRICS
-    if isinstance(text, Constraint):
-        c = text
-    else:
-        if isinstance(text, tuple) and len(text) == 3:
-            name, sense, value = text
-        else:
-            m = _CONSTRAINT.match(str(text))
-            if m is None:
-                raise ParameterError("--subject-to", text, "NAME>=VALUE or NAME<=VALUE, e.g. first_frequency>=800")
-            name, sense, value = m.groups()
-        if name not in METRICS:
-            raise UnknownNameError("metric (--subject-to)", str(name), METRICS)
-        if sense not in (">=", "<="):
-            raise ParameterError("--subject-to", text, "NAME>=VALUE or NAME<=VALUE")
-        unit = METRIC_UNITS.get(name, "-")
-        c = Constraint(str(name), sense, to_si(value if isinstance(value, str) else float(value), unit,
-                                               f"--subject-to {name}"))
-    return c
 
 
 def parse_bounds(name: str, value, actuator=None) -> Tuple[float, float]:
@@ -206,198 +158,6 @@ class OptimizeResult:
         return d
 
 
-class _Budget(MjeapError):
-    """The evaluation budget is spent."""
-
-
-class _Failed(MjeapError):
-    """An evaluation failed (its row's error): the start that asked for it stops."""
-
-
-def _number(v) -> float:
-    """A metric's value (a row's, live or read back from the CSV) as a float."""
-    if isinstance(v, (bool, np.bool_)):
-        return float(v)
-    if isinstance(v, str):
-        if v in ("True", "False"):
-            return float(v == "True")
-        if v == "":
-            return math.nan
-        return float(v)
-    return float(v)
-
-
-class _Evaluations:
-    """The evaluations of one optimisation: points by their u in [0, 1]^n, each evaluated
-    once (:func:`mjeap.studies.sweep.evaluate`, serial, in this process) or read from the CSV,
-    appended to it as they finish."""
-
-    def __init__(self, names, lo, hi, metrics, base, cached, out, columns, max_evaluations, bar,
-                 objective, sign, constraints, feasibility):
-        self.names, self.lo, self.hi = names, np.asarray(lo, float), np.asarray(hi, float)
-        self.metrics, self.base, self.cached, self.out, self.columns = metrics, base, cached, out, columns
-        self.max_evaluations, self.bar = max_evaluations, bar
-        self.objective, self.sign, self.constraints, self.feasibility = objective, sign, constraints, feasibility
-        self.rows: Dict[str, dict] = {}
-        self.order: List[str] = []
-        self._us: List[np.ndarray] = []                        # u of self.order's points
-        self.run = self.read = 0
-        self.scale = 1.0
-        self.best: Optional[Tuple[float, str]] = None         # (signed objective, point id) of the best feasible
-        self.least: Optional[Tuple[float, str]] = None        # (violation, point id): the least infeasible
-
-    def aim(self, objective: str, sign: float, constraints) -> None:
-        """Ask another question of the same evaluations (a Pareto front's next point): the
-        best and least infeasible ranked again over every row so far."""
-        self.objective, self.sign, self.constraints = objective, sign, list(constraints)
-        self.best = self.least = None
-        for pid in self.order:
-            self._rank(pid, self.rows[pid])
-
-    def u_of(self, point: dict) -> np.ndarray:
-        """The scaled u in [0, 1]^n of a point (SI)."""
-        return (np.array([point[n] for n in self.names]) - self.lo) / (self.hi - self.lo)
-
-    def point(self, u) -> dict:
-        u = np.clip(np.asarray(u, float), 0.0, 1.0)
-        x = self.lo + u * (self.hi - self.lo)
-        return {n: float(v) for n, v in zip(self.names, x)}
-
-    #: points closer than this (in the box scaled to [0, 1]) are the same design: the nearest
-    #: evaluated one answers (a line search shrinking its step below it stops there instead of
-    #: spending the budget on designs no one could tell apart)
-    RESOLUTION = 1e-9
-
-    def __call__(self, u) -> dict:
-        from .sweep import evaluate, point_id
-        p = self.point(u)
-        pid = point_id(p, self.base, self.metrics)
-        row = self.rows.get(pid)
-        if row is not None:
-            return row
-        if self._us:
-            uu = np.clip(np.asarray(u, float), 0.0, 1.0)
-            d = np.max(np.abs(np.asarray(self._us) - uu), axis=1)
-            k = int(np.argmin(d))
-            if d[k] < self.RESOLUTION:
-                return self.rows[self.order[k]]
-        if len(self.rows) >= self.max_evaluations:
-            raise _Budget(f"the budget of {self.max_evaluations} evaluations is spent")
-        if pid in self.cached:
-            row = dict(self.cached[pid])
-            self.read += 1
-        else:
-            row = evaluate(p, self.metrics, self.base)
-            row.pop("_error_model", None)
-            if self.out is not None:
-                self.out.write([row.get(k, "") for k in self.columns], len(self.cached) + self.run)
-            self.run += 1
-            row = {**row, **{m: _readback(row[m]) for m in self.metrics}}
-        row["_point"] = p
-        self.rows[pid] = row
-        self.order.append(pid)
-        self._us.append(np.clip(np.asarray(u, float), 0.0, 1.0))
-        self._rank(pid, row)
-        if self.bar is not None:
-            self.bar.update(1)
-            if self.best is not None:
-                self.bar.set_postfix_str(f"best {self.objective} {self.sign * self.best[0]:.5g}", refresh=False)
-        return row
-
-    def _rank(self, pid, row):
-        if row.get("error"):
-            return
-        try:
-            f = self.sign * _number(row[self.objective])
-            margins = [c.margin(_number(row[c.metric])) for c in self.constraints]
-        except (TypeError, ValueError):
-            return
-        if not math.isfinite(f) or not all(math.isfinite(m) for m in margins):
-            return
-        violation = sum(max(0.0, -m) for m in margins)
-        if violation <= self.feasibility:
-            if self.best is None or f > self.best[0]:
-                self.best = (f, pid)
-        elif self.least is None or violation < self.least[0]:
-            self.least = (violation, pid)
-
-    def values(self, u) -> Tuple[float, np.ndarray]:
-        """(scaled objective to minimise, scaled constraint margins >= 0) at u; a failed point
-        raises _Failed."""
-        row = self(u)
-        if row.get("error"):
-            raise _Failed(f"{row['error'].split(' | ')[0]} (at {row['_point']})")
-        f = -self.sign * _number(row[self.objective]) / self.scale
-        g = np.array([c.margin(_number(row[c.metric])) for c in self.constraints])
-        if not math.isfinite(f) or not np.all(np.isfinite(g)):
-            raise _Failed(f"a metric is not a number at {row['_point']}")
-        return f, g
-
-
-def _readback(v):
-    """A metric's value as the CSV gives it back (so a rerun from the cache is the same)."""
-    from ..io.csvio import plain_cell
-    if isinstance(v, (float, np.floating)):
-        return float(repr(float(v)))
-    return plain_cell(v)
-
-
-def _fd(ev: _Evaluations, u: np.ndarray, h: float):
-    """(objective, margins, their gradients) at u by forward differences of h (backward at
-    the upper bound)."""
-    f0, g0 = ev.values(u)
-    n = u.size
-    df, dg = np.zeros(n), np.zeros((g0.size, n))
-    for i in range(n):
-        step = h if u[i] + h <= 1.0 else -h
-        v = u.copy()
-        v[i] += step
-        f1, g1 = ev.values(v)
-        df[i], dg[:, i] = (f1 - f0) / step, (g1 - g0) / step
-    return f0, g0, df, dg
-
-
-def _slsqp(ev: _Evaluations, u0, fd_step, tol, maxiter):
-    from scipy.optimize import minimize
-    n = len(u0)
-    cons = []
-    for j in range(len(ev.constraints)):
-        cons.append({"type": "ineq", "fun": lambda u, j=j: ev.values(u)[1][j],
-                     "jac": lambda u, j=j: _fd(ev, np.asarray(u, float), fd_step)[3][j]})
-    res = minimize(lambda u: ev.values(u)[0], np.asarray(u0, float),
-                   jac=lambda u: _fd(ev, np.asarray(u, float), fd_step)[2], method="SLSQP",
-                   bounds=[(0.0, 1.0)] * n, constraints=cons, options={"maxiter": maxiter, "ftol": tol})
-    return res
-
-
-def _differential_evolution(ev: _Evaluations, seed, tol, budget, popsize):
-    """scipy's differential_evolution on [0, 1]^n (Latin hypercube, seeded), no polish (SLSQP
-    polishes after it), at most ``budget`` evaluations; ``tol`` its convergence tolerance
-    (the population's spread of the objective relative to its mean)."""
-    from scipy.optimize import NonlinearConstraint, differential_evolution
-    n = len(ev.names)
-    big = 1e30
-
-    def f(u):
-        try:
-            return ev.values(u)[0]
-        except _Failed:
-            return big
-
-    def g(u):
-        try:
-            return ev.values(u)[1]
-        except _Failed:
-            return np.full(len(ev.constraints), -big)
-
-    kw = {}
-    if ev.constraints:
-        kw["constraints"] = NonlinearConstraint(g, 0.0, np.inf)
-    gens = max(1, budget // (popsize * n) - 1)
-    return differential_evolution(f, [(0.0, 1.0)] * n, seed=seed, maxiter=gens, popsize=popsize, tol=tol,
-                                  init="latinhypercube", polish=False, updating="immediate", **kw)
-
-
 def _base_actuator(actuator, folder: Optional[Path]):
     """The study's ``actuator`` setting: a catalog id or a file's path as given; an Actuator
     object is written as an actuator file (in the output folder, else a temporary one)."""
@@ -438,7 +198,7 @@ def _wave_settings(voltage) -> dict:
     return out
 
 
-def optimize(actuator, vary: Mapping[str, object], maximize: Optional[str] = None, minimize: Optional[str] = None,
+def optimize(actuator, vary: Mapping[str, object], *, maximize: Optional[str] = None, minimize: Optional[str] = None,
              subject_to: Sequence = (), voltage: Optional[str] = None, duration: Optional[float] = None,
              base: Optional[dict] = None, metrics: Sequence[str] = (), method: str = "slsqp", starts: int = 3,
              seed: int = 0, max_evaluations: int = 400, out=None, progress: Optional[bool] = None,
@@ -473,15 +233,8 @@ def optimize(actuator, vary: Mapping[str, object], maximize: Optional[str] = Non
     With the ``report`` extra (matplotlib) ``optimize.png`` shows the search (module text).
     ``slice_points``: evaluations of each variable swept through the optimum, the others
     held (the figure's lines; 0: none), within the budget and written as the others are."""
-    from ..model import variants
-    from ..io.outputs import check_outputs, hold, replacing
-    from ..model.actuator_file import actuator_toml, is_actuator_file
-    from .sweep import METRICS, STATIC_METRICS, check_metric_settings, check_settings
-    from .sweep.points import check_names
-    from .store import RowFile, drop_torn_row, read_study_csv
-
     t0 = time.perf_counter()
-    # ---- the question, checked before any work
+    # ---- the question and the search's settings, checked before any work
     front = None if pareto is None else _parse_pareto(pareto)
     if front is not None:
         if maximize is not None or minimize is not None:
@@ -489,364 +242,287 @@ def optimize(actuator, vary: Mapping[str, object], maximize: Optional[str] = Non
                                  "minimise, not both")
         pareto_points = check_integer("pareto_points", pareto_points, 3, 100)
         (maximize, minimize) = (front[0][0], None) if front[0][1] > 0 else (None, front[0][0])
-    if (maximize is None) == (minimize is None):
-        raise ParameterError("maximize/minimize", f"maximize={maximize!r}, minimize={minimize!r}",
-                             "exactly one metric to maximise or to minimise")
-    objective, sign = (maximize, 1.0) if maximize is not None else (minimize, -1.0)
-    if objective not in METRICS:
-        raise UnknownNameError("metric (--maximize/--minimize)", str(objective), METRICS)
-    constraints = [parse_constraint(c) for c in ([subject_to] if isinstance(subject_to, str) else subject_to)]
-    extra = list(metrics.split(",")) if isinstance(metrics, str) else list(metrics)
-    for m in extra:
-        if m not in METRICS:
-            raise UnknownNameError("metric (--metrics)", m, METRICS)
-    wanted = list(dict.fromkeys([objective, *(c.metric for c in constraints), *extra,
-                                 *([] if front is None else [front[1][0]])]))
-    method = str(method).strip().lower().replace("_", "-")
-    if method not in METHODS:
-        raise ParameterError("method", method, f"one of {', '.join(METHODS)}")
-    starts = check_integer("starts", starts, 1, 100)
-    seed = check_integer("seed", seed, 0)
-    max_evaluations = check_integer("max_evaluations", max_evaluations, 2)
-    popsize = check_integer("popsize", popsize, 4, 1000)
+    goal = _goal(maximize, minimize, subject_to, feasibility, active)
+    wanted = _wanted(goal, metrics, front)
+    settings = _search_settings(method=method, starts=starts, seed=seed, tol=tol, fd_step=fd_step, maxiter=maxiter,
+                                popsize=popsize, de_tol=de_tol, max_evaluations=max_evaluations)
     slice_points = check_integer("slice_points", slice_points, 0, 1000)
-    maxiter = check_integer("maxiter", maxiter, 1)
-    fd_step = check_range("fd_step", fd_step, 0.0, 0.1, "(of the box)", lo_open=True)
-    tol = check_range("tol", tol, 0.0, 0.1, lo_open=True)
-    de_tol = check_range("de_tol", de_tol, 0.0, 1.0, lo_open=True)
-    feasibility = check_range("feasibility", feasibility, 0.0, 0.1)
-    active = check_range("active", active, 0.0, 1.0)
     if not isinstance(vary, Mapping) or not vary:
         raise ParameterError("vary", vary, "at least one parameter with its bounds: {'actuator.length': "
                              "('5mm', '15mm')} (--vary NAME=LOW:HIGH)")
     folder = Path(out) if out is not None else None
-    files = {}
-    if folder is not None:
-        if folder.exists() and not folder.is_dir():
-            raise ParameterError("--out", str(folder), "a folder for result.json, evaluations.csv and optimum.toml",
-                                 "it is a file")
-        files = {k: folder / v for k, v in (("result", RESULT), ("evaluations", EVALUATIONS), ("optimum", OPTIMUM),
-                                            ("figure", FIGURE), ("least_infeasible", LEAST_INFEASIBLE))}
-        if front is not None:
-            files.update(pareto=folder / PARETO, pareto_figure=folder / PARETO_FIGURE)
-        named = {f"--out ({p.name})": p for p in files.values()}
-        if not isinstance(actuator, (str, Path)):
-            named[f"--out ({BASE})"] = folder / BASE
-        # names mjeap picks: regular files or none, never a link, never the base actuator's file
-        check_outputs(inputs=[("base actuator file", actuator if isinstance(actuator, (str, Path)) and
-                               is_actuator_file(actuator) else None)], picked=named, **named)
+    files = _files(folder, actuator, front)
     base_name, tmp = _base_actuator(actuator, folder)
     try:
-        fixed = dict(base or {})
-        if "actuator" in fixed:
-            raise ParameterError("base", "actuator", "the actuator as optimize's first argument, not in base/--set")
-        check_names(fixed)
-        fixed["actuator"] = base_name
-        act0 = variants.get_base(base_name)
-        names = sorted(vary)
-        bounds = [parse_bounds(n, vary[n], base_name) for n in names]
-        clash = [n for n in names if n in fixed]
-        if clash:
-            raise ParameterError("--set", clash[0], "a setting that is not also varied (--vary)")
-        needs_run = any(m not in STATIC_METRICS for m in wanted)
-        if voltage is not None:
-            fixed.update(_wave_settings(voltage))
-        elif needs_run and "waveform" not in fixed:
-            raise ParameterError("voltage", None, "a waveform for the rollouts of "
-                                 f"{', '.join(m for m in wanted if m not in STATIC_METRICS)}: e.g. --voltage step:200V")
-        if duration is not None:
-            fixed["duration"] = float(duration)
-        if needs_run and fixed.get("waveform") == "step" and fixed.get("duration") in (None, ""):
-            raise ParameterError("duration", None, "a duration in s for a step (--duration)")
-        lo, hi = np.array([b[0] for b in bounds]), np.array([b[1] for b in bounds])
-        corners = [{n: float(v) for n, v in zip(names, x)} for x in (lo, hi, 0.5 * (lo + hi))]
-        check_settings(corners, fixed)
-        check_metric_settings(corners, fixed, wanted)
-        for c in corners:                       # the box's corners build (a stack the drive takes)
-            variants.design_actuator(base_name, c)
-        _check_fields(base_name, fixed, corners, constraints)
-        columns = ["point_id", *names, *wanted, "error", "wall_s", "settings"]
+        box, fixed = _box(base_name, vary, base, voltage, duration, goal, wanted)
+        columns = ["point_id", *box.names, *wanted, "error", "wall_s", "settings"]
+        study = _Study(box, goal, settings, wanted, fixed, columns, base_name, front, pareto_points, slice_points)
         # ---- the run
         from threadpoolctl import threadpool_limits
         with sigterm_as_interrupt(), threadpool_limits(1):
             if folder is None:
-                return _run(names, lo, hi, wanted, fixed, {}, None, columns, max_evaluations, progress, objective,
-                            sign, constraints, feasibility, method, starts, seed, tol, fd_step, maxiter, popsize,
-                            active, base_name, t0, files, act0, de_tol, front, pareto_points, slice_points)
-            csv_path = files["evaluations"]
-            with hold(csv_path, "--out (evaluations.csv)", holder="mjeap optimize", picked=True):
-                drop_torn_row(csv_path)
-                cached, delimiter = {}, ","
-                if csv_path.exists() and csv_path.stat().st_size > 0:
-                    header, rows, delimiter = read_study_csv(csv_path)
-                    if header != columns:
-                        raise ParameterError("--out", str(csv_path), f"the evaluations of this optimisation (columns "
-                                             f"{columns}); it has {header}: choose another --out")
-                    cached = {r["point_id"]: r for r in rows}
-                writer = RowFile(csv_path, delimiter, "--out (evaluations.csv)")
-                try:
-                    if not cached:
-                        writer.write(columns, 0)
-                    result = _run(names, lo, hi, wanted, fixed, cached, writer, columns, max_evaluations, progress,
-                                  objective, sign, constraints, feasibility, method, starts, seed, tol, fd_step,
-                                  maxiter, popsize, active, base_name, t0, files, act0, de_tol, front, pareto_points, slice_points)
-                finally:
-                    writer.close()
-            # the point's actuator file: named optimum only where the point is feasible
-            which = "optimum" if result.feasible else "least_infeasible"
-            result.files = {k: v for k, v in result.files.items()
-                            if k not in ("optimum", "least_infeasible") or (k == which and result.actuator is not None)}
-            if result.actuator is not None:
-                with replacing(files[which], f"--out ({files[which].name})", picked=True) as t:
-                    Path(t).write_text(actuator_toml(result.actuator), encoding="utf-8")
-            if front is not None:
-                _write_front(files["pareto"], result.pareto, front, names, base_name)
-            drawn = _draw(result, files, names, lo, hi, constraints, front, base_name)
-            if drawn:
-                result.message += f"; {drawn}"
-                for k in ("figure", "pareto_figure"):
-                    result.files.pop(k, None)
-            text = json.dumps(result.as_dict(), indent=2, default=float)
-            with replacing(files["result"], "--out (result.json)", picked=True) as t:
-                Path(t).write_text(text + "\n", encoding="utf-8")
+                return _run(study, cached={}, writer=None, progress=progress, t0=t0, files=files)
+            result = _run_stored(study, files, progress=progress, t0=t0)
+            _write_result(result, study, files)
             return result
     finally:
         if tmp is not None:
             tmp.cleanup()
 
 
-def _search(ev: _Evaluations, method, starts, seed, tol, fd_step, maxiter, popsize, de_tol, max_evaluations,
-            first=None) -> Tuple[List[dict], List[str]]:
-    """One question's search over ``ev`` (aimed at it): SLSQP from ``first`` (a u) or the
-    box's centre and ``starts - 1`` seeded points, or differential evolution polished by
-    SLSQP. Returns the starts' reports and messages; the budget spent ends it."""
-    n = len(ev.names)
-    runs, messages = [], []
-    centre = np.full(n, 0.5)
-    try:                               # the objective's scale: its magnitude at the box's centre
-        f_c = _number(ev(centre)[ev.objective]) if not ev(centre).get("error") else math.nan
-    except _Budget:
-        f_c = math.nan
-    except (TypeError, ValueError):
-        f_c = math.nan
-    ev.scale = abs(f_c) if math.isfinite(f_c) and f_c != 0 else 1.0
-    if first is not None:
-        u_starts = [np.asarray(first, float)]
-    elif method == "slsqp":
-        rng = np.random.default_rng(seed)
-        u_starts = [centre] + [rng.uniform(0.0, 1.0, n) for _ in range(starts - 1)]
-    else:
-        u_starts = [None]
-    for k, u0 in enumerate(u_starts):
-        before = len(ev.rows)
-        info = {"start": "previous optimum" if first is not None else "centre" if (u0 is not None and k == 0) else (
-            "differential evolution" if u0 is None else f"seeded {k}")}
+@dataclass(frozen=True)
+class _Study:
+    """An optimisation checked and ready to run: its box, goal and search settings, the
+    metrics each point reads, the points' fixed settings, the CSV's columns, the base
+    actuator's name, the Pareto front asked for (and its points) and the slices' points."""
+
+    box: Box
+    goal: Goal
+    settings: SearchSettings
+    wanted: List[str]
+    fixed: dict
+    columns: List[str]
+    base_name: str
+    front: Optional[tuple]
+    pareto_points: int
+    slice_points: int
+
+
+def _goal(maximize, minimize, subject_to, feasibility: float, active: float) -> Goal:
+    """The question: one metric maximised or minimised, the constraints, the tolerances."""
+    from .sweep import METRICS
+    if (maximize is None) == (minimize is None):
+        raise ParameterError("maximize/minimize", f"maximize={maximize!r}, minimize={minimize!r}",
+                             "exactly one metric to maximise or to minimise")
+    objective, sign = (maximize, 1.0) if maximize is not None else (minimize, -1.0)
+    if objective not in METRICS:
+        raise UnknownNameError("metric (--maximize/--minimize)", str(objective), METRICS)
+    constraints = tuple(parse_constraint(c) for c in ([subject_to] if isinstance(subject_to, str) else subject_to))
+    return Goal(objective, sign, constraints, check_range("feasibility", feasibility, 0.0, 0.1),
+                check_range("active", active, 0.0, 1.0))
+
+
+def _wanted(goal: Goal, metrics, front) -> List[str]:
+    """Every metric a point reads: the objective, the constrained ones, ``metrics``, the
+    front's second."""
+    from .sweep import METRICS
+    extra = list(metrics.split(",")) if isinstance(metrics, str) else list(metrics)
+    for m in extra:
+        if m not in METRICS:
+            raise UnknownNameError("metric (--metrics)", m, METRICS)
+    return list(dict.fromkeys([goal.objective, *(c.metric for c in goal.constraints), *extra,
+                               *([] if front is None else [front[1][0]])]))
+
+
+def _search_settings(*, method, starts, seed, tol, fd_step, maxiter, popsize, de_tol, max_evaluations) -> SearchSettings:
+    """The search's settings, each checked against its range."""
+    method = str(method).strip().lower().replace("_", "-")
+    if method not in METHODS:
+        raise ParameterError("method", method, f"one of {', '.join(METHODS)}")
+    return SearchSettings(method=method, starts=check_integer("starts", starts, 1, 100),
+                          seed=check_integer("seed", seed, 0),
+                          tol=check_range("tol", tol, 0.0, 0.1, lo_open=True),
+                          fd_step=check_range("fd_step", fd_step, 0.0, 0.1, "(of the box)", lo_open=True),
+                          maxiter=check_integer("maxiter", maxiter, 1),
+                          popsize=check_integer("popsize", popsize, 4, 1000),
+                          de_tol=check_range("de_tol", de_tol, 0.0, 1.0, lo_open=True),
+                          max_evaluations=check_integer("max_evaluations", max_evaluations, 2))
+
+
+def _files(folder: Optional[Path], actuator, front) -> Dict[str, Path]:
+    """The files an optimisation writes in ``folder`` (none without one), checked before any
+    work: names mjeap picks, regular files or none, never a link, never the base actuator's
+    file."""
+    from ..io.outputs import check_outputs
+    from ..model.actuator_file import is_actuator_file
+    if folder is None:
+        return {}
+    if folder.exists() and not folder.is_dir():
+        raise ParameterError("--out", str(folder), "a folder for result.json, evaluations.csv and optimum.toml",
+                             "it is a file")
+    files = {k: folder / v for k, v in (("result", RESULT), ("evaluations", EVALUATIONS), ("optimum", OPTIMUM),
+                                        ("figure", FIGURE), ("least_infeasible", LEAST_INFEASIBLE))}
+    if front is not None:
+        files.update(pareto=folder / PARETO, pareto_figure=folder / PARETO_FIGURE)
+    named = {f"--out ({p.name})": p for p in files.values()}
+    if not isinstance(actuator, (str, Path)):
+        named[f"--out ({BASE})"] = folder / BASE
+    check_outputs(inputs=[("base actuator file", actuator if isinstance(actuator, (str, Path)) and
+                           is_actuator_file(actuator) else None)], picked=named, **named)
+    return files
+
+
+def _box(base_name: str, vary: Mapping, base: Optional[dict], voltage, duration, goal: Goal,
+         wanted: List[str]) -> Tuple[Box, dict]:
+    """The box (its bounds checked, its corners built and checked as sweep points) and the
+    points' fixed settings (``base``, the waveform of ``voltage``, ``duration``)."""
+    from ..model import variants
+    from .sweep import STATIC_METRICS, check_metric_settings, check_settings
+    from .sweep.points import check_names
+    fixed = dict(base or {})
+    if "actuator" in fixed:
+        raise ParameterError("base", "actuator", "the actuator as optimize's first argument, not in base/--set")
+    check_names(fixed)
+    fixed["actuator"] = base_name
+    names = sorted(vary)
+    bounds = [parse_bounds(n, vary[n], base_name) for n in names]
+    clash = [n for n in names if n in fixed]
+    if clash:
+        raise ParameterError("--set", clash[0], "a setting that is not also varied (--vary)")
+    needs_run = any(m not in STATIC_METRICS for m in wanted)
+    if voltage is not None:
+        fixed.update(_wave_settings(voltage))
+    elif needs_run and "waveform" not in fixed:
+        raise ParameterError("voltage", None, "a waveform for the rollouts of "
+                             f"{', '.join(m for m in wanted if m not in STATIC_METRICS)}: e.g. --voltage step:200V")
+    if duration is not None:
+        fixed["duration"] = float(duration)
+    if needs_run and fixed.get("waveform") == "step" and fixed.get("duration") in (None, ""):
+        raise ParameterError("duration", None, "a duration in s for a step (--duration)")
+    lo, hi = np.array([b[0] for b in bounds]), np.array([b[1] for b in bounds])
+    corners = [{n: float(v) for n, v in zip(names, x)} for x in (lo, hi, 0.5 * (lo + hi))]
+    check_settings(corners, fixed)
+    check_metric_settings(corners, fixed, wanted)
+    for c in corners:                       # the box's corners build (a stack the drive takes)
+        variants.design_actuator(base_name, c)
+    _check_fields(base_name, fixed, corners, goal.constraints)
+    return Box(tuple(names), lo, hi), fixed
+
+
+def _run_stored(study: _Study, files: Dict[str, Path], *, progress, t0: float) -> OptimizeResult:
+    """:func:`_run` with its evaluations appended to ``evaluations.csv`` (held for the run),
+    those already there read back as a cache."""
+    from ..io.outputs import hold
+    from .store import RowFile, drop_torn_row, read_study_csv
+    csv_path, columns = files["evaluations"], study.columns
+    with hold(csv_path, "--out (evaluations.csv)", holder="mjeap optimize", picked=True):
+        drop_torn_row(csv_path)
+        cached, delimiter = {}, ","
+        if csv_path.exists() and csv_path.stat().st_size > 0:
+            header, rows, delimiter = read_study_csv(csv_path)
+            if header != columns:
+                raise ParameterError("--out", str(csv_path), f"the evaluations of this optimisation (columns "
+                                     f"{columns}); it has {header}: choose another --out")
+            cached = {r["point_id"]: r for r in rows}
+        writer = RowFile(csv_path, delimiter, "--out (evaluations.csv)")
         try:
-            if u0 is None:
-                de = _differential_evolution(ev, seed, de_tol, int(0.8 * max_evaluations), popsize)
-                info.update(evolution=str(de.message), generations=int(de.nit))
-                u0 = np.asarray(de.x, float)
-                info["polish"] = True
-            if u0 is not None:
-                info["from"] = ev.point(u0)
-                res = _slsqp(ev, u0, fd_step, tol, maxiter)
-                info.update(message=str(res.message), success=bool(res.success), iterations=int(res.nit),
-                            to=ev.point(res.x))
-                ev(res.x)
-        except _Budget as e:
-            info.update(message=str(e), success=False)
-            messages.append(str(e))
-            info["evaluations"] = len(ev.rows) - before
-            runs.append(info)
-            break
-        except _Failed as e:
-            info.update(message=f"stopped: an evaluation failed: {e}", success=False)
-        info["evaluations"] = len(ev.rows) - before
-        runs.append(info)
-        messages.append(info["message"])
-    return runs, messages
+            if not cached:
+                writer.write(columns, 0)
+            return _run(study, cached=cached, writer=writer, progress=progress, t0=t0, files=files)
+        finally:
+            writer.close()
 
 
-def _run(names, lo, hi, wanted, fixed, cached, writer, columns, max_evaluations, progress, objective, sign,
-         constraints, feasibility, method, starts, seed, tol, fd_step, maxiter, popsize, active, base_name, t0,
-         files, act0, de_tol=1e-2, pareto=None, pareto_points=7, slice_points=11) -> OptimizeResult:
+def _write_result(result: OptimizeResult, study: _Study, files: Dict[str, Path]) -> None:
+    """The point's actuator file (named optimum only where it is feasible), the front, the
+    figures and result.json, each whole or not at all."""
+    from ..io.outputs import replacing
+    from ..model.actuator_file import actuator_toml
+    which = "optimum" if result.feasible else "least_infeasible"
+    result.files = {k: v for k, v in result.files.items()
+                    if k not in ("optimum", "least_infeasible") or (k == which and result.actuator is not None)}
+    if result.actuator is not None:
+        with replacing(files[which], f"--out ({files[which].name})", picked=True) as t:
+            Path(t).write_text(actuator_toml(result.actuator), encoding="utf-8")
+    box = study.box
+    if study.front is not None:
+        write_front(files["pareto"], result.pareto, study.front, list(box.names), study.base_name)
+    drawn = draw(result, files, list(box.names), box.lo, box.hi, list(study.goal.constraints), study.front,
+                 study.base_name)
+    if drawn:
+        result.message += f"; {drawn}"
+        for k in ("figure", "pareto_figure"):
+            result.files.pop(k, None)
+    text = json.dumps(result.as_dict(), indent=2, default=float)
+    with replacing(files["result"], "--out (result.json)", picked=True) as t:
+        Path(t).write_text(text + "\n", encoding="utf-8")
+
+
+def _run(study: _Study, *, cached: dict, writer, progress, t0: float, files: Dict[str, Path]) -> OptimizeResult:
+    """The search of ``study`` (and its front), then the result at the best point."""
+    goal, settings = study.goal, study.settings
     bar = None
     if progress or (progress is None and sys.stderr.isatty()):
         try:
             from tqdm import tqdm
-            bar = tqdm(total=max_evaluations, unit="eval", desc=f"optimize {objective}")
+            bar = tqdm(total=settings.max_evaluations, unit="eval", desc=f"optimize {goal.objective}")
         except ImportError:  # pragma: no cover
             bar = None
-    ev = _Evaluations(names, lo, hi, wanted, fixed, cached, writer, columns, max_evaluations, bar, objective, sign,
-                      constraints, feasibility)
-    search = dict(method=method, starts=starts, seed=seed, tol=tol, fd_step=fd_step, maxiter=maxiter,
-                  popsize=popsize, de_tol=de_tol, max_evaluations=max_evaluations)
+    ev = Evaluations(study.box, goal, metrics=study.wanted, base=study.fixed, cached=cached, out=writer,
+                     columns=study.columns, max_evaluations=settings.max_evaluations, bar=bar)
     front = None
     try:
-        runs, messages = _search(ev, **search)
-        if pareto is not None:
-            front = _trace_front(ev, pareto, constraints, pareto_points, search, runs)
-            ev.aim(objective, sign, constraints)            # back to the first metric's question
+        runs, messages = search(ev, settings)
+        if study.front is not None:
+            front = trace_front(ev, study.front, list(goal.constraints), study.pareto_points, settings, runs)
+            ev.aim(goal.objective, goal.sign, goal.constraints)     # back to the first metric's question
     finally:
         if bar is not None:
             bar.close()
     pick = ev.best or ev.least
     if pick is None:
         errors = [ev.rows[p]["error"].split(" | ")[0] for p in ev.order if ev.rows[p].get("error")]
-        raise ParameterError("optimisation", objective, "a box where some evaluation succeeds",
+        raise ParameterError("optimisation", goal.objective, "a box where some evaluation succeeds",
                              f"all {len(ev.rows)} evaluations failed: {errors[0] if errors else 'no values'}")
-    row = ev.rows[pick[1]]
+    return _result(study, ev, ev.rows[pick[1]], runs=runs, messages=messages, front=front, t0=t0, files=files)
+
+
+def _result(study: _Study, ev: Evaluations, row: dict, *, runs, messages, front, t0: float,
+            files: Dict[str, Path]) -> OptimizeResult:
+    """The optimisation's answer at ``row`` (the best feasible point, else the least
+    infeasible): its metrics, constraints, sensitivities, slices and actuator."""
+    goal, wanted = study.goal, study.wanted
     point = row["_point"]
-    values = {m: _clean(row[m]) for m in wanted}
+    values = {m: clean(row[m]) for m in wanted}
     cons = []
-    for c in constraints:
-        v = _number(row[c.metric])
+    for c in goal.constraints:
+        v = number(row[c.metric])
         cons.append({"expression": c.expression, "metric": c.metric, "bound": c.bound, "value": v,
-                     "margin": c.margin(v), "met": c.margin(v) >= -feasibility, "active": abs(c.margin(v)) <= active})
+                     "margin": c.margin(v), "met": c.margin(v) >= -goal.feasibility,
+                     "active": abs(c.margin(v)) <= goal.active})
     feasible = ev.best is not None
-    sensitivities = _sensitivities(ev, row, constraints, active, fd_step, base_name) if feasible else []
-    slices = _slices(ev, ev.u_of(point), slice_points)
-    act = None
-    try:
-        from ..model.variants import design_actuator
-        act = design_actuator(base_name, {**fixed, **point})     # fixed actuator.X (--set) too
-        drive_set = {k[6:]: v for k, v in {**fixed, **point}.items() if k.startswith("drive.")}
-        if drive_set:
-            act = dataclasses.replace(act, drive_parameters={
-                **act.drive_parameters, **{k: (float(v), "", "set by mjeap optimize") for k, v in drive_set.items()}})
-        sense = "maximise" if sign > 0 else "minimise"
-        act = dataclasses.replace(
-            act, id=f"{act0.id}-optimum" if feasible else f"{act0.id}-least-infeasible",
-            title=f"{act0.title}, optimised ({sense} {objective})" if feasible else
-            f"{act0.title}, least infeasible point ({sense} {objective}: no point met the constraints)",
-            notes=(act0.notes + "\n" if act0.notes else "") + f"mjeap optimize: {sense} {objective}"
-            + (f" subject to {', '.join(c.expression for c in constraints)}" if constraints else "")
-            + f" over {', '.join(f'{n} in [{a:g}, {b:g}]' for n, a, b in zip(names, lo, hi))}; optimum "
-            + ", ".join(f"{k} = {v:.6g}" for k, v in point.items()))
-    except MjeapError:
-        act = None
-    evaluated = [(ev.rows[p]["_point"], {m: _clean(ev.rows[p].get(m, "")) for m in wanted}, ev.rows[p].get("error", ""))
+    sens = sensitivities(ev, row, list(goal.constraints), goal.active, study.settings.fd_step, study.base_name) \
+        if feasible else []
+    swept = slices(ev, ev.u_of(point), study.slice_points)
+    evaluated = [(ev.rows[p]["_point"], {m: clean(ev.rows[p].get(m, "")) for m in wanted}, ev.rows[p].get("error", ""))
                  for p in ev.order]
     return OptimizeResult(
         optimum=dict(point), metrics=values,
-        objective={"metric": objective, "sense": "maximize" if sign > 0 else "minimize", "value": values[objective]},
+        objective={"metric": goal.objective, "sense": "maximize" if goal.sign > 0 else "minimize",
+                   "value": values[goal.objective]},
         constraints=cons, evaluations=len(ev.rows), evaluations_run=ev.run, evaluations_cached=ev.read,
         success=feasible and any(r.get("success") for r in runs),
         message="; ".join(dict.fromkeys(messages)) + ("" if feasible else "; no feasible point found: the least "
                                                        "infeasible is reported"),
-        method=method, wall_s=time.perf_counter() - t0, runs=runs, actuator=act,
-        files={k: str(v) for k, v in files.items()}, sensitivities=sensitivities, pareto=front, evaluated=evaluated,
-        slices=slices, feasible=feasible)
+        method=study.settings.method, wall_s=time.perf_counter() - t0, runs=runs,
+        actuator=_point_actuator(study, point, feasible),
+        files={k: str(v) for k, v in files.items()}, sensitivities=sens, pareto=front, evaluated=evaluated,
+        slices=swept, feasible=feasible)
 
 
-def _slices(ev: _Evaluations, u: np.ndarray, points: int) -> Dict[str, List[tuple]]:
-    """Each variable swept over its range through the optimum (the others held there):
-    name -> [(point, {metric: value}, error)]; where the budget runs out, what was reached."""
-    out: Dict[str, List[tuple]] = {}
-    if points < 2:
-        return out
-    for i, name in enumerate(ev.names):
-        rows = []
-        for ui in np.linspace(0.0, 1.0, points):
-            v = u.copy()
-            v[i] = ui
-            try:
-                r = ev(v)
-            except _Budget:
-                break
-            rows.append((r["_point"], {m: _clean(r.get(m, "")) for m in ev.metrics}, r.get("error", "")))
-        out[name] = rows
-    return out
-
-
-def _trace_front(ev: _Evaluations, pareto, constraints, points: int, search: dict, runs: List[dict]) -> List[dict]:
-    """The Pareto front between ``pareto`` ((M1, sign), (M2, sign)) by the epsilon-constraint
-    method (module text), ``ev`` holding the best M1 already; each level starts from the
-    previous optimum. Returns the front's points, sorted along M2."""
-    (m1, s1), (m2, s2) = pareto
-    found = []
-
-    def take(kind):
-        pick = ev.best
-        if pick is None:
-            found.append({"kind": kind, "feasible": False})
-            return None
-        row = ev.rows[pick[1]]
-        found.append({"kind": kind, "feasible": True, m1: _number(row[m1]), m2: _number(row[m2]), **row["_point"]})
-        return ev.u_of(row["_point"])
-
-    u_a = take(f"best {m1}")
-    ev.aim(m2, s2, constraints)
-    more, _ = _search(ev, **{**search, "starts": 1}, first=u_a)
-    runs.extend({**r, "question": f"best {m2}"} for r in more)
-    if ev.best is not None:      # the best M2 that is not dominated: the best M1 at (nearly) that M2
-        best2 = s2 * ev.best[0]
-        c = Constraint(m2, ">=" if s2 > 0 else "<=", best2 - s2 * 1e-3 * abs(best2))
-        ev.aim(m1, s1, [*constraints, c])
-        more, _ = _search(ev, **{**search, "starts": 1}, first=ev.u_of(ev.rows[ev.best[1]]["_point"])
-                          if ev.best is not None else None)
-        runs.extend({**r, "question": f"best {m1} at {c.expression}"} for r in more)
-    u_b = take(f"best {m2}")
-    if u_a is not None and u_b is not None:
-        a, b = found[0][m2], found[1][m2]
-        u_prev = u_a
-        for eps in np.linspace(a, b, points)[1:-1]:
-            c = Constraint(m2, ">=" if s2 > 0 else "<=", float(eps))
-            ev.aim(m1, s1, [*constraints, c])
-            more, _ = _search(ev, **{**search, "starts": 1}, first=u_prev)
-            runs.extend({**r, "question": f"best {m1} at {c.expression}"} for r in more)
-            u_prev = take(f"{m2} {c.sense} {eps:.6g}") if ev.best is not None else u_prev
-    front = [f for f in found if f["feasible"]]
-    return sorted(front, key=lambda f: f[m2]) + [f for f in found if not f["feasible"]]
-
-
-def _sensitivities(ev: _Evaluations, row: dict, constraints, active: float, fd_step: float, actuator) -> List[dict]:
-    """The objective's sensitivity to each active constraint's bound and each variable at a
-    bound (module text): KKT multipliers by least squares from forward differences at the
-    optimum (steps into the box)."""
-    from .parameters import parameter_unit
-    from .sweep import METRIC_UNITS
-    x = row["_point"]
-    u = ev.u_of(x)
-    act_c = [c for c in constraints if abs(c.margin(_number(row[c.metric]))) <= active]
-    bounds = [(i, "lower" if u[i] <= active else "upper") for i in range(u.size) if u[i] <= active or u[i] >= 1 - active]
-    if not act_c and not bounds:
-        return []
-    span = ev.hi - ev.lo
-    f0 = _number(row[ev.objective])
-    c0 = np.array([_number(row[c.metric]) for c in act_c])
-    df, dc = np.zeros(u.size), np.zeros((len(act_c), u.size))
+def _point_actuator(study: _Study, point: dict, feasible: bool):
+    """The actuator of ``point`` (the fixed actuator.X and drive.NAME settings too), named and
+    noted as the optimum or the least infeasible point; None where it does not build."""
+    from ..model.variants import design_actuator, get_base
+    goal, fixed, box = study.goal, study.fixed, study.box
     try:
-        for i in range(u.size):
-            h = fd_step if u[i] + fd_step <= 1.0 else -fd_step
-            v = u.copy()
-            v[i] += h
-            r1 = ev(v)
-            if r1.get("error"):
-                raise _Failed(r1["error"].split(" | ")[0])
-            df[i] = (_number(r1[ev.objective]) - f0) / (h * span[i])
-            dc[:, i] = (np.array([_number(r1[c.metric]) for c in act_c]) - c0) / (h * span[i])
-    except (_Budget, _Failed) as e:
-        return [{"note": f"not computed: {e}"}]
-    A = np.column_stack([*dc, *[np.eye(u.size)[i] for i, _ in bounds]]) if (act_c or bounds) else np.zeros((u.size, 0))
-    lam, *_ = np.linalg.lstsq(A, df, rcond=None)
-    residual = float(np.linalg.norm(A @ lam - df) / max(np.linalg.norm(df), 1e-300))
-    unit = METRIC_UNITS.get(ev.objective, "-")
-    out = []
-    for c, mu in zip(act_c, lam):
-        out.append({"kind": "constraint", "bound": c.expression, "sensitivity": float(mu),
-                    "unit": f"{unit} per {METRIC_UNITS.get(c.metric, '-')}",
-                    "meaning": f"d {ev.objective} / d bound: the optimum's change per unit change of the bound"})
-    for (i, side), nu in zip(bounds, lam[len(act_c):]):
-        name = ev.names[i]
-        vunit = parameter_unit(name, actuator) or VARIABLE.get(name, ("-",))[0]
-        out.append({"kind": f"{side} bound", "bound": f"{name} {'>=' if side == 'lower' else '<='} "
-                    f"{(ev.lo if side == 'lower' else ev.hi)[i]:g}", "sensitivity": float(nu),
-                    "unit": f"{unit} per {vunit}",
-                    "meaning": f"d {ev.objective} / d bound: the optimum's change per unit change of the bound"})
-    for o in out:
-        o["kkt_residual"] = residual
-    return out
+        act0 = get_base(study.base_name)
+        act = design_actuator(study.base_name, {**fixed, **point})     # fixed actuator.X (--set) too
+        drive_set = {k[6:]: v for k, v in {**fixed, **point}.items() if k.startswith("drive.")}
+        if drive_set:
+            act = dataclasses.replace(act, drive_parameters={
+                **act.drive_parameters, **{k: (float(v), "", "set by mjeap optimize") for k, v in drive_set.items()}})
+        sense = "maximise" if goal.sign > 0 else "minimise"
+        return dataclasses.replace(
+            act, id=f"{act0.id}-optimum" if feasible else f"{act0.id}-least-infeasible",
+            title=f"{act0.title}, optimised ({sense} {goal.objective})" if feasible else
+            f"{act0.title}, least infeasible point ({sense} {goal.objective}: no point met the constraints)",
+            notes=(act0.notes + "\n" if act0.notes else "") + f"mjeap optimize: {sense} {goal.objective}"
+            + (f" subject to {', '.join(c.expression for c in goal.constraints)}" if goal.constraints else "")
+            + f" over {', '.join(f'{n} in [{a:g}, {b:g}]' for n, a, b in zip(box.names, box.lo, box.hi))}; optimum "
+            + ", ".join(f"{k} = {v:.6g}" for k, v in point.items()))
+    except MjeapError:
+        return None
 
 
 def _check_fields(actuator, fixed: dict, corners: List[dict], constraints) -> None:
@@ -901,157 +577,3 @@ def _parse_pareto(pareto) -> Tuple[Tuple[str, float], Tuple[str, float]]:
     return out[0], out[1]
 
 
-def _write_front(path, front: List[dict], pareto, names, actuator) -> None:
-    """``pareto.csv``: the front's points, its two metrics and the variables, units in the
-    header (mjeap.io.csvio's writer, whole or not at all)."""
-    from .parameters import parameter_unit
-    from ..io import csvio
-    from ..io.outputs import replacing
-    from .sweep import METRIC_UNITS
-    (m1, _), (m2, _) = pareto
-    unit = lambda n: METRIC_UNITS.get(n) or parameter_unit(n, actuator) or VARIABLE.get(n, ("-",))[0]  # noqa: E731
-    keys = [m1, m2, *names]
-    with replacing(path, "--out (pareto.csv)") as tmp, open(tmp, "w", newline="") as fh:
-        w = csvio.writer(fh)
-        w.writerow([f"{k} ({unit(k)})" for k in keys] + ["point"])
-        for f in front:
-            if f["feasible"]:
-                w.writerow([f[k] for k in keys] + [f["kind"]])
-
-
-def _draw(result: OptimizeResult, files, names, lo, hi, constraints, front, actuator) -> str:
-    """Draw ``optimize.png`` (and ``pareto.png``) where matplotlib is installed; '' when
-    drawn, else why not."""
-    try:
-        import matplotlib
-    except ImportError:
-        return "figures skipped: pip install -e '.[report]' for matplotlib"
-    matplotlib.use("Agg")
-    _draw_search(files["figure"], result, names, lo, hi, constraints, actuator)
-    if front is not None:
-        _draw_front(files["pareto_figure"], result, front, constraints)
-    return ""
-
-
-def _unit(name: str, actuator) -> str:
-    from .parameters import parameter_unit
-    from .sweep import METRIC_UNITS
-    return METRIC_UNITS.get(name) or parameter_unit(name, actuator) or VARIABLE.get(name, ("-",))[0]
-
-
-def _axis(ax, which: str, unit: str) -> None:
-    from matplotlib.ticker import EngFormatter
-    if unit not in ("-", ""):
-        (ax.xaxis if which == "x" else ax.yaxis).set_major_formatter(EngFormatter(unit=unit.replace("^", "")))
-
-
-def _draw_search(path, result: OptimizeResult, names, lo, hi, constraints, actuator) -> None:
-    """optimize.png: a column per variable, a row for the objective and one per constrained
-    metric; every evaluation (feasible filled, infeasible hollow), the optimum starred, each
-    constraint's bound dashed (red where active), a variable's active bound a vertical line."""
-    import matplotlib.pyplot as plt
-    obj = result.objective["metric"]
-    rows = list(dict.fromkeys([obj, *(c.metric for c in constraints)]))
-    ok = [(p, m) for p, m, e in result.evaluated if not e]
-    feas = [all(c.margin(_number(m[c.metric])) >= -1e-6 for c in constraints) for _, m in ok]
-    fig, axes = plt.subplots(len(rows), len(names), figsize=(4.4 * len(names) + 0.6, 2.9 * len(rows) + 0.9),
-                             squeeze=False, sharex="col")
-    for j, name in enumerate(names):
-        x = np.array([p[name] for p, _ in ok])
-        for i, metric in enumerate(rows):
-            ax = axes[i, j]
-            y = np.array([_number(m[metric]) for _, m in ok])
-            f = np.array(feas, bool)
-            ax.scatter(x[f], y[f], s=12, color="0.55", label="search: feasible")
-            ax.scatter(x[~f], y[~f], s=12, facecolors="none", edgecolors="0.6", label="search: infeasible")
-            cut = [(p[name], _number(m[metric])) for p, m, e in result.slices.get(name, ()) if not e]
-            if cut:
-                ax.plot(*np.array(cut).T, "-", color="C0", lw=1.6,
-                        label="through the optimum" if len(names) > 1 else "over the range")
-            ax.plot([result.optimum[name]], [_number(result.metrics[metric])], "*", color="C3", ms=14,
-                    label="optimum")
-            for c, info in zip(constraints, result.constraints):
-                if c.metric == metric:
-                    ax.axhline(c.bound, ls="--", color="C3" if info["active"] else "0.5",
-                               label=_pretty(c) + (" (active)" if info["active"] else ""))
-            for side, b in (("lower", lo[j]), ("upper", hi[j])):
-                if abs(result.optimum[name] - b) <= 1e-3 * (hi[j] - lo[j]):
-                    ax.axvline(b, color="C2", lw=2, label=f"{side} bound of {name} (active)")
-            _axis(ax, "y", _unit(metric, actuator))
-            ax.set_ylabel(f"{metric}")
-            if i == len(rows) - 1:
-                from matplotlib.ticker import MaxNLocator
-                _axis(ax, "x", _unit(name, actuator))
-                ax.xaxis.set_major_locator(MaxNLocator(5))
-                ax.set_xlabel(name)
-            ax.grid(alpha=0.3)
-            ax.legend(fontsize=7, loc="best")
-    import textwrap
-    sense = result.objective["sense"]
-    title = f"mjeap optimize: {sense} {obj}" + (f" subject to {', '.join(_pretty(c) for c in constraints)}"
-                                                if constraints else "")
-    fig.suptitle(textwrap.fill(title, 90) + f"\nevery evaluation of the search ({len(result.evaluated)})", fontsize=9)
-    fig.tight_layout()
-    _save(fig, path, "--out (optimize.png)")
-
-
-def _margins(metrics: dict, constraints) -> List[dict]:
-    return [{"met": c.margin(_number(metrics[c.metric])) >= -1e-6} for c in constraints]
-
-
-def _pretty(c: "Constraint") -> str:
-    """A constraint with its bound in engineering notation and its metric's unit."""
-    from matplotlib.ticker import EngFormatter
-    unit = _unit(c.metric, None)
-    bound = EngFormatter(unit=unit.replace("^", "") if unit not in ("-", "") else "", sep="\u00a0")(c.bound)
-    return f"{c.metric} {'>=' if c.sense == '>=' else '<='} {bound}"
-
-
-def _draw_front(path, result: OptimizeResult, pareto, constraints=()) -> None:
-    """pareto.png: every evaluation (hollow where it violates a constraint) and the traced
-    front between the two metrics."""
-    import matplotlib.pyplot as plt
-    (m1, s1), (m2, s2) = pareto
-    fig, ax = plt.subplots(figsize=(6.4, 4.8))
-    for feasible in (True, False):
-        a = np.array([[_number(m[m1]), _number(m[m2])] for _, m, e in result.evaluated
-                      if not e and all(c["met"] for c in _margins(m, constraints)) == feasible]).reshape(-1, 2)
-        if feasible:
-            ax.scatter(a[:, 1], a[:, 0], s=10, color="0.55", label="evaluations meeting the constraints")
-        elif a.size:
-            ax.scatter(a[:, 1], a[:, 0], s=10, facecolors="none", edgecolors="0.7", label="evaluations violating one")
-    front = [f for f in result.pareto if f["feasible"]]
-    ax.plot([f[m2] for f in front], [f[m1] for f in front], "o-", color="C3", label="Pareto front (epsilon-constraint)")
-    for k, f in enumerate(front):
-        if f["kind"].startswith("best"):
-            last = k == len(front) - 1
-            ax.annotate(f["kind"], (f[m2], f[m1]), textcoords="offset points", xytext=(-8 if last else 8, 8),
-                        ha="right" if last else "left", fontsize=8)
-    ax.margins(0.08)
-    _axis(ax, "x", _unit(m2, None))
-    _axis(ax, "y", _unit(m1, None))
-    ax.set_xlabel(f"{m2} ({'maximised' if s2 > 0 else 'minimised'})")
-    ax.set_ylabel(f"{m1} ({'maximised' if s1 > 0 else 'minimised'})")
-    ax.grid(alpha=0.3)
-    ax.legend(fontsize=8)
-    ax.set_title(f"mjeap optimize --pareto {m1},{m2}: {len(front)} points"
-                 + (f"\nsubject to {', '.join(_pretty(c) for c in constraints)}" if constraints else ""), fontsize=10)
-    fig.tight_layout()
-    _save(fig, path, "--out (pareto.png)")
-
-
-def _save(fig, path, name: str) -> None:
-    import matplotlib.pyplot as plt
-    from ..io.outputs import replacing
-    try:
-        with replacing(path, name) as tmp:
-            fig.savefig(tmp, dpi=110, format="png")
-    finally:
-        plt.close(fig)
-
-
-def _clean(v):
-    try:
-        return _number(v)
-    except (TypeError, ValueError):
-        return v

@@ -3,16 +3,24 @@ unit and their value. ``actuator.X`` takes its field's unit (:mod:`mjeap.model.v
 ``drive.NAME`` the drive's own, the sweep's parameters theirs (:data:`SWEEP_UNITS`)."""
 from __future__ import annotations
 
+import math
 from typing import Optional
 
 from ..model.variants import design_unit, get_base, is_design_parameter, parse_design_name
 
-__all__ = ["SWEEP_UNITS", "parameter_unit", "to_value"]
+__all__ = ["SWEEP_UNITS", "VARIABLE", "parameter_unit", "to_value"]
 
 #: units of the sweep's own numeric parameters (mjeap.studies.sweep.PARAMETERS)
 SWEEP_UNITS = {"payload_mass": "kg", "payload_position": "m", "amplitude": "V", "frequency": "Hz", "offset": "V",
                "duration": "s", "initial_curvature": "1/m", "damping_ratio": "-", "accuracy": "-",
                "stop_when_periodic": "-"}
+
+#: the sweep parameters an optimisation (mjeap.studies.optimize) may vary besides actuator.X and drive.NAME: (unit, low, high,
+#: low open) - the range a bound must lie in
+VARIABLE = {"payload_mass": ("kg", 0.0, math.inf, False), "payload_position": ("m", 0.0, math.inf, True),
+            "amplitude": ("V", -math.inf, math.inf, False), "offset": ("V", -math.inf, math.inf, False),
+            "frequency": ("Hz", 0.0, math.inf, True), "initial_curvature": ("1/m", -math.inf, math.inf, False),
+            "damping_ratio": ("-", 0.0, 10.0, True)}
 
 
 def parameter_unit(name: str, actuator=None) -> Optional[str]:
