@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import List, Optional, Sequence
 
-from ...errors import (DivergenceError, MjeapError, ParameterError, UnknownNameError, check_integer, sigterm_as_interrupt)
+from ...errors import DivergenceError, MjeapError, ParameterError, UnknownNameError, check_integer, sigterm_as_interrupt
 from ...io.outputs import check_outputs, hold, output_kind
 from ..store import RowFile, drop_torn_row, read_study_csv
 from ...model.laminate import FieldWarning
@@ -419,7 +419,7 @@ def _run_in(pools: _Pools, pending: _SceneQueue, workers: int):
                 alone.shutdown(wait=False, cancel_futures=True)
 
 
-def run_sweep(points: Sequence[dict], path, metrics: Sequence[str] = ("peak_to_peak", "returns"),
+def run_sweep(points: Sequence[dict], path, *, metrics: Sequence[str] = ("peak_to_peak", "returns"),
               base: Optional[dict] = None, executor: str = "processes", workers: int = 2,
               scheduler: Optional[str] = None, record: Sequence[int] = (), rrd_dir=None,
               progress: Optional[bool] = None, share_error_models: bool = True) -> SweepSummary:
@@ -460,8 +460,8 @@ def run_sweep(points: Sequence[dict], path, metrics: Sequence[str] = ("peak_to_p
     # the CSV's lock for the whole sweep (PATH.lock): a second sweep on it, or a run writing it,
     # is refused (it would compute every point twice and duplicate rows)
     with hold(path, "path", holder="mjeap sweep"):
-        return _run_locked(points, path, metrics, base, executor, workers, scheduler, record, rrd_dir, progress,
-                           bool(share_error_models))
+        return _run_locked(points, path, metrics, base, executor=executor, workers=workers, scheduler=scheduler,
+                           record=record, rrd_dir=rrd_dir, progress=progress, share=bool(share_error_models))
 
 
 def sweep_inputs(points: Sequence[dict], base: Optional[dict] = None) -> list:
@@ -473,12 +473,13 @@ def sweep_inputs(points: Sequence[dict], base: Optional[dict] = None) -> list:
     return [("actuator file", f) for f in files]
 
 
-def _run_locked(points, path, metrics, base, executor, workers, scheduler, record, rrd_dir, progress, share=True):
+def _run_locked(points, path, metrics, base, *, executor, workers, scheduler, record, rrd_dir, progress, share=True):
     stream = output_kind(path) == "stream"             # /dev/stdout, a FIFO: written through, never read back
     if not stream:
         drop_torn_row(path)
     done_ids, header, delimiter = set(), None, ","
-    if not stream and path.exists() and path.stat().st_size > 0:   # resumed: read as users' CSVs are, appended in its form
+    # resumed: read as users' CSVs are, appended in its form
+    if not stream and path.exists() and path.stat().st_size > 0:
         header, rows, delimiter = read_study_csv(path)
         done_ids = {row["point_id"] for row in rows}
     rrd_dir = str(rrd_dir or path.parent / (path.stem + "-rrd"))
@@ -501,11 +502,11 @@ def _run_locked(points, path, metrics, base, executor, workers, scheduler, recor
             bar = None
     t0 = time.perf_counter()
     with sigterm_as_interrupt():
-        return _write_rows(path, columns, new_file, executor, workers, scheduler, jobs, bar, skipped, t0, share,
-                           delimiter)
+        return _write_rows(path, columns, new_file, executor=executor, workers=workers, scheduler=scheduler, jobs=jobs,
+                           bar=bar, skipped=skipped, t0=t0, share=share, delimiter=delimiter)
 
 
-def _write_rows(path, columns, new_file, executor, workers, scheduler, jobs, bar, skipped, t0, share=True,
+def _write_rows(path, columns, new_file, *, executor, workers, scheduler, jobs, bar, skipped, t0, share=True,
                 delimiter=","):
     failed, done = 0, 0
     out = RowFile(path, delimiter)
