@@ -43,7 +43,7 @@ import math
 import re
 import sys
 from pathlib import Path
-from typing import Dict, Optional
+from typing import Dict, Optional, Tuple
 
 from ..errors import ParameterError, UnknownNameError
 from . import materials as mat
@@ -165,107 +165,20 @@ def read_actuator(path):
     src = doc.get("sources", {})
     if not isinstance(src, dict):
         raise r.error("sources", src, "a table of sources: key = \"where the number comes from\"")
-    # the drive: a name, or a table with name, parameters and sources
-    if drive_table is not None:
-        r.unknown(drive_table, ("name", "parameters", "sources"), "drive.")
-        drive = r.text(drive_table, "name", "drive.", required=True)
-    else:
-        drive = r.text(doc, "drive", required=True)
-    if _drive_info is not None:
-        try:
-            _drive_info.units(drive)
-        except UnknownNameError as e:
-            raise _unknown(r.where("drive"), "drive", drive, e.known) from None
-    # planform
-    pf = doc.get("planform")
-    if not isinstance(pf, dict):
-        raise r.error("planform", pf if pf is not None else "missing", "a [planform] table with length and base_width")
-    r.unknown(pf, PLANFORM_KEYS, "planform.")
-    num = lambda k, **kw: r.number(pf, k, _UNITS[k], "planform.", **kw)  # noqa: E731
-    length, base = num("length", required=True), num("base_width", required=True)
-    planform = Planform(length=length, base_width=base, tip_width=num("tip_width", default=base),
-                        source=r.text(pf, "source", "planform.", default="given in the file"),
-                        extension_length=num("extension_length", positive=False, default=0.0),
-                        extension_mass=num("extension_mass", positive=False, default=0.0),
-                        extension_source=r.text(pf, "extension_source", "planform.", default="none"),
-                        residual_tip_mass=num("residual_tip_mass", positive=False, default=0.0),
-                        residual_source=r.text(pf, "residual_source", "planform.", default="none"))
-    if planform.extension_mass > 0 and planform.extension_length == 0:
-        raise r.error("planform.extension_length", 0, "a positive length where extension_mass is given")
-    # layers
+    drive = _drive_name(r, doc, drive_table)
+    planform = _planform(r, doc)
     layers_doc = doc.get("layers")
     if not isinstance(layers_doc, list) or not layers_doc:
         raise r.error("layers", layers_doc if layers_doc is not None else "missing",
                       "at least one [[layers]] table, bottom to top")
     layers, names = [], set()
     for i, ld in enumerate(layers_doc):
-        pre = f"layers[{i}]."
-        if not isinstance(ld, dict):
-            raise r.error(f"layers[{i}]", ld, "a [[layers]] table")
-        r.unknown(ld, LAYER_KEYS, pre)
-        name = r.text(ld, "name", pre, required=True)
-        if name in names:
-            raise r.error(pre + "name", name, "a name no other layer has")
-        names.add(name)
-        pre = f"layers.{name}."
-        m = None
-        if "material" in ld:
-            key = r.text(ld, "material", pre)
-            try:
-                m = mat.get_material(key)
-            except UnknownNameError as e:
-                raise _unknown(r.where(pre + "material"), "material", key, mat.MATERIALS) from None
-        values = {}
-        for k in ("youngs_modulus", "density", "poisson_ratio"):
-            if k in ld:
-                v = r.number(ld, k, _UNITS[k], pre, positive=k != "poisson_ratio")
-                if k == "poisson_ratio" and not -1.0 < v < 0.5:
-                    raise r.error(pre + k, ld[k], "a Poisson ratio in (-1, 0.5)")
-                mat.check_value(m, k, v, r.where(pre + k))
-                values[k] = v
-            elif m is not None:
-                values[k] = m.property(k).value
-            else:
-                raise r.error(pre + k, "missing", f"a value in {_UNITS[k]}, or a material from the library "
-                              f"({', '.join(mat.material_names())}) to take it from")
-        sources = ld.get("sources", {})
-        if not isinstance(sources, dict) or not all(isinstance(v, str) for v in sources.values()):
-            raise r.error(pre + "sources", sources, "a table of texts: field = \"source\"")
-        if m is not None:       # what the layer takes from the material carries its source
-            sources = {**{k: f"material {m.name}: {m.property(k).source}" for k in values if k not in ld}, **sources}
-        piezo = _piezo_keys(r, ld, pre, values["youngs_modulus"], m)
-        if "e31" in ld and "d31" not in ld and "d31" not in sources:   # d31 carries e31's source
-            sources = {**sources, "d31": f"e31 = {ld['e31']} / youngs_modulus; e31: "
-                       + sources.get("e31", r.text(ld, "source", pre, default="not given"))}
-        layers.append(Layer(name=name, material=r.text(ld, "description", pre, default=m.title if m else name),
-                            thickness=r.number(ld, "thickness", "m", pre, required=True),
-                            width=r.number(ld, "width", "m", pre, default=None), source=r.text(
-                                ld, "source", pre, default="given in the file"),
-                            sources=dict(sources), role=r.text(ld, "role", pre, default=""),
-                            material_key=m.name if m else None, **values, **piezo))
-    # overrides
-    overrides = {}
-    for k in ("flexural_rigidity", "mass"):
-        if k not in doc:
-            continue
-        v = doc[k]
-        if isinstance(v, dict):
-            r.unknown(v, ("value", "source"), f"{k}.")
-            val = r.number(v, "value", _UNITS[k], f"{k}.", required=True)
-            s = r.text(v, "source", f"{k}.", default=src.get(k, "given in the file"))
-        else:
-            val = r.number(doc, k, _UNITS[k])
-            s = src.get(k, "given in the file")
-        overrides[k] = Sourced(val, _UNITS[k], s)
+        layers.append(_layer(r, i, ld, names))
+    overrides = _overrides(r, doc, src)
     zeta = r.number(doc, "damping_ratio", "-", required=True)
     if not zeta < 1.0:
         raise r.error("damping_ratio", doc["damping_ratio"], "a damping ratio in (0, 1)")
-    vr = doc.get("voltage_range")
-    if not isinstance(vr, list) or len(vr) != 2:
-        raise r.error("voltage_range", vr if vr is not None else "missing", "[low, high] in V, e.g. [\"0 V\", \"200 V\"]")
-    lo, hi = (to_si(v, "V", r.where(f"voltage_range[{i}]")) for i, v in enumerate(vr))
-    if not lo < hi:
-        raise r.error("voltage_range", vr, "[low, high] with low < high")
+    lo, hi = _voltage_range(r, doc)
     plane = doc.get("plane_strain")
     if plane is not None and not isinstance(plane, bool):
         raise r.error("plane_strain", plane, "true or false")
@@ -294,6 +207,122 @@ def read_actuator(path):
         raise r.error("layers", [f"{l.name} ({l.role or 'no role'})" for l in act.layers],
                       f"a layer stack the {drive} drive can take", why)
     return act
+
+
+def _drive_name(r: _Reader, doc: dict, drive_table: Optional[dict]) -> str:
+    """The file's drive: a name, or a table with name, parameters and sources; known to the
+    drive layer where it has told its drives."""
+    if drive_table is not None:
+        r.unknown(drive_table, ("name", "parameters", "sources"), "drive.")
+        drive = r.text(drive_table, "name", "drive.", required=True)
+    else:
+        drive = r.text(doc, "drive", required=True)
+    if _drive_info is not None:
+        try:
+            _drive_info.units(drive)
+        except UnknownNameError as e:
+            raise _unknown(r.where("drive"), "drive", drive, e.known) from None
+    return drive
+
+
+def _planform(r: _Reader, doc: dict) -> Planform:
+    """The [planform] table."""
+    pf = doc.get("planform")
+    if not isinstance(pf, dict):
+        raise r.error("planform", pf if pf is not None else "missing", "a [planform] table with length and base_width")
+    r.unknown(pf, PLANFORM_KEYS, "planform.")
+    num = lambda k, **kw: r.number(pf, k, _UNITS[k], "planform.", **kw)  # noqa: E731
+    length, base = num("length", required=True), num("base_width", required=True)
+    planform = Planform(length=length, base_width=base, tip_width=num("tip_width", default=base),
+                        source=r.text(pf, "source", "planform.", default="given in the file"),
+                        extension_length=num("extension_length", positive=False, default=0.0),
+                        extension_mass=num("extension_mass", positive=False, default=0.0),
+                        extension_source=r.text(pf, "extension_source", "planform.", default="none"),
+                        residual_tip_mass=num("residual_tip_mass", positive=False, default=0.0),
+                        residual_source=r.text(pf, "residual_source", "planform.", default="none"))
+    if planform.extension_mass > 0 and planform.extension_length == 0:
+        raise r.error("planform.extension_length", 0, "a positive length where extension_mass is given")
+    return planform
+
+
+def _layer(r: _Reader, i: int, ld, names: set) -> Layer:
+    """The ``i``-th [[layers]] table (its name added to ``names``, which no other may take):
+    its numbers given or taken from its material, each with its source."""
+    pre = f"layers[{i}]."
+    if not isinstance(ld, dict):
+        raise r.error(f"layers[{i}]", ld, "a [[layers]] table")
+    r.unknown(ld, LAYER_KEYS, pre)
+    name = r.text(ld, "name", pre, required=True)
+    if name in names:
+        raise r.error(pre + "name", name, "a name no other layer has")
+    names.add(name)
+    pre = f"layers.{name}."
+    m = None
+    if "material" in ld:
+        key = r.text(ld, "material", pre)
+        try:
+            m = mat.get_material(key)
+        except UnknownNameError:
+            raise _unknown(r.where(pre + "material"), "material", key, mat.MATERIALS) from None
+    values = {}
+    for k in ("youngs_modulus", "density", "poisson_ratio"):
+        if k in ld:
+            v = r.number(ld, k, _UNITS[k], pre, positive=k != "poisson_ratio")
+            if k == "poisson_ratio" and not -1.0 < v < 0.5:
+                raise r.error(pre + k, ld[k], "a Poisson ratio in (-1, 0.5)")
+            mat.check_value(m, k, v, r.where(pre + k))
+            values[k] = v
+        elif m is not None:
+            values[k] = m.property(k).value
+        else:
+            raise r.error(pre + k, "missing", f"a value in {_UNITS[k]}, or a material from the library "
+                          f"({', '.join(mat.material_names())}) to take it from")
+    sources = ld.get("sources", {})
+    if not isinstance(sources, dict) or not all(isinstance(v, str) for v in sources.values()):
+        raise r.error(pre + "sources", sources, "a table of texts: field = \"source\"")
+    if m is not None:       # what the layer takes from the material carries its source
+        sources = {**{k: f"material {m.name}: {m.property(k).source}" for k in values if k not in ld}, **sources}
+    piezo = _piezo_keys(r, ld, pre, values["youngs_modulus"], m)
+    if "e31" in ld and "d31" not in ld and "d31" not in sources:   # d31 carries e31's source
+        sources = {**sources, "d31": f"e31 = {ld['e31']} / youngs_modulus; e31: "
+                   + sources.get("e31", r.text(ld, "source", pre, default="not given"))}
+    return Layer(name=name, material=r.text(ld, "description", pre, default=m.title if m else name),
+                 thickness=r.number(ld, "thickness", "m", pre, required=True),
+                 width=r.number(ld, "width", "m", pre, default=None), source=r.text(
+                     ld, "source", pre, default="given in the file"),
+                 sources=dict(sources), role=r.text(ld, "role", pre, default=""),
+                 material_key=m.name if m else None, **values, **piezo)
+
+
+def _overrides(r: _Reader, doc: dict, src: dict) -> dict:
+    """The measured overrides (flexural_rigidity, mass), each a number or a table with its
+    value and source."""
+    overrides = {}
+    for k in ("flexural_rigidity", "mass"):
+        if k not in doc:
+            continue
+        v = doc[k]
+        if isinstance(v, dict):
+            r.unknown(v, ("value", "source"), f"{k}.")
+            val = r.number(v, "value", _UNITS[k], f"{k}.", required=True)
+            s = r.text(v, "source", f"{k}.", default=src.get(k, "given in the file"))
+        else:
+            val = r.number(doc, k, _UNITS[k])
+            s = src.get(k, "given in the file")
+        overrides[k] = Sourced(val, _UNITS[k], s)
+    return overrides
+
+
+def _voltage_range(r: _Reader, doc: dict) -> Tuple[float, float]:
+    """``voltage_range = [low, high]`` in V, low < high."""
+    vr = doc.get("voltage_range")
+    if not isinstance(vr, list) or len(vr) != 2:
+        raise r.error("voltage_range", vr if vr is not None else "missing",
+                      "[low, high] in V, e.g. [\"0 V\", \"200 V\"]")
+    lo, hi = (to_si(v, "V", r.where(f"voltage_range[{i}]")) for i, v in enumerate(vr))
+    if not lo < hi:
+        raise r.error("voltage_range", vr, "[low, high] with low < high")
+    return lo, hi
 
 
 def _piezo_keys(r: _Reader, ld: dict, pre: str, youngs_modulus: float, material) -> dict:

@@ -57,11 +57,63 @@ def simulated_edges(mass: Sequence[float], amplitude: Sequence[float], returns: 
     return edges
 
 
-MAP_DESCRIPTION = "Stability map of the PEDOT micro trilayer standing up (Dadras et al. 2021): payload mass x drive amplitude."
+MAP_DESCRIPTION = ("Stability map of the PEDOT micro trilayer standing up (Dadras et al. 2021): payload mass x drive "
+                   "amplitude.")
 
 
 def main(argv=None):
     """The map's command line: ``python scripts/stability_map.py --help``."""
+    a = parse_args(_parser(), argv)
+    if a.accuracy is not None:
+        from ..simulation.accuracy import check_accuracy
+        check_accuracy(a.accuracy)
+    out = Path(a.out)
+    # the files it names itself, checked before any work: regular files or none, never a link
+    named = {f"--out ({n})": out / n for n in ("stability_map.png", "report.md", "stability_map.rrd")}
+    check_outputs(picked=named, **named)
+    masses = np.linspace(0.0, 150e-6, a.masses)[1:]
+    amps = np.linspace(0.25, 1.5, a.amplitudes)
+    points = grid(payload_mass=[float(m) for m in masses], amplitude=[float(v) for v in amps])
+    # at a target the map asks for its answer, read on the last period (relaxed steps,
+    # mjeap.simulation.metric_accuracy); the stress proxy reads the release transient
+    metrics = (("returns", "peak_to_peak", "estimated_error") if a.accuracy else
+               ("returns", "peak_to_peak", "max_stress_proxy")) + \
+        (("stopped_early",) if a.stop_when_periodic else ())
+    base = {**MAP_BASE, "engine": a.engine, "duration": a.periods * (1.0 / MAP_BASE["frequency"]),
+            **({"accuracy": a.accuracy} if a.accuracy else {}),
+            **({"stop_when_periodic": a.stop_when_periodic} if a.stop_when_periodic else {})}
+    s = run_sweep(points, out / "results.csv", metrics=metrics, base=base,
+                  executor=a.executor, workers=a.workers)
+    print(f"{s.done} rollouts in {s.wall_s:.1f} s ({s.throughput:.2f}/s), {s.skipped} already done, {s.failed} failed")
+    rows = read_results(out / "results.csv")
+    m = np.array([float(r["payload_mass"]) for r in rows]) * 1e6
+    v = np.array([float(r["amplitude"]) for r in rows])
+    ok = np.array([r["returns"] == "True" for r in rows])
+    bounds = {k: b * 1e6 for k, b in column_limits().items()}
+    sim_edge = simulated_edges(m, v, ok)
+    lines = ["# Stability map: pedot-micro standing up, payload at l_e = 6.27 mm, 0.1 Hz square wave", "",
+             f"{len(rows)} points of {a.periods} periods; criterion: tip curvature changes sign in the last period "
+             "(Dadras et al. 2021: the third)"
+             + (f"; stopped once periodic within {a.stop_when_periodic:g} (stopped_early)"
+                if a.stop_when_periodic else "") + ".", "",
+             "| amplitude (V) | simulated limit (mg) |", "|---|---|"]
+    lines += [f"| {amp:.3g} | {edge:.1f} |" for amp, edge in sim_edge.items()]
+    lines += ["", "| theory (amplitude independent) | mass (mg) |", "|---|---|"]
+    lines += [f"| {k} | {b:.1f} |" for k, b in bounds.items()]
+    lines += ["", "Below the relaxed column load the beam holds any amplitude; above it, the drive's own moment "
+              "pushes the column back through straight each half period, so the drive-following limit rises "
+              "with amplitude (validation: 99.7 mg at 1.5 V), up to the instantaneous column load."]
+    _figure(out, m, v, ok, bounds, lines)
+    with replacing(out / "report.md", "--out (report.md)", picked=True) as tmp:
+        tmp.write_text("\n".join(lines) + "\n")
+
+    _recording(out, m, v, ok, lines)
+    print("\n".join(lines))
+    print(f"wrote {out / 'report.md'}, {out / 'stability_map.rrd'}")
+
+
+def _parser() -> argparse.ArgumentParser:
+    """The map's options."""
     ap = argparse.ArgumentParser(description=MAP_DESCRIPTION)
     ap.add_argument("--out", default="out/stability", type=arg_output(inside="results.csv"),
                     help="folder of results.csv, stability_map.png, report.md and stability_map.rrd")
@@ -79,50 +131,19 @@ def main(argv=None):
                          "and timestep chosen per point, steps far beyond the beam's modes where the drive is slow; "
                          "estimates in the estimated_error.METRIC columns (max_stress_proxy is then not reported)")
     ap.add_argument("--periods", type=arg_integer(1, 1000), default=3,
-                    help="drive periods (10 s each) a point runs, the criterion read on the last (Dadras et al. 2021: 3)")
+                    help="drive periods (10 s each) a point runs, the criterion read on the last (Dadras et al. 2021: "
+                         "3)")
     ap.add_argument("--stop-when-periodic", type=float, default=None, metavar="TOL",
                     help="stop a point once its last drive period repeats the one before within TOL (1e-6 to 0.2, "
                          "of the tip curvature's range and of the length) and its shrinking change still to come "
                          "stays within it: its outcome is decided; the stopped_early column says where (from the "
                          "third period's end on: needs --periods 4 or more; refused before any point otherwise)")
-    a = parse_args(ap, argv)
-    if a.accuracy is not None:
-        from ..simulation.accuracy import check_accuracy
-        check_accuracy(a.accuracy)
-    out = Path(a.out)
-    # the files it names itself, checked before any work: regular files or none, never a link
-    named = {f"--out ({n})": out / n for n in ("stability_map.png", "report.md", "stability_map.rrd")}
-    check_outputs(picked=named, **named)
-    masses = np.linspace(0.0, 150e-6, a.masses)[1:]
-    amps = np.linspace(0.25, 1.5, a.amplitudes)
-    points = grid(payload_mass=[float(m) for m in masses], amplitude=[float(v) for v in amps])
-    # at a target the map asks for its answer, read on the last period (relaxed steps,
-    # mjeap.simulation.metric_accuracy); the stress proxy reads the release transient
-    metrics = (("returns", "peak_to_peak", "estimated_error") if a.accuracy else
-               ("returns", "peak_to_peak", "max_stress_proxy")) + \
-        (("stopped_early",) if a.stop_when_periodic else ())
-    base = {**MAP_BASE, "engine": a.engine, "duration": a.periods * (1.0 / MAP_BASE["frequency"]), **({"accuracy": a.accuracy} if a.accuracy else {}),
-            **({"stop_when_periodic": a.stop_when_periodic} if a.stop_when_periodic else {})}
-    s = run_sweep(points, out / "results.csv", metrics=metrics, base=base,
-                  executor=a.executor, workers=a.workers)
-    print(f"{s.done} rollouts in {s.wall_s:.1f} s ({s.throughput:.2f}/s), {s.skipped} already done, {s.failed} failed")
-    rows = read_results(out / "results.csv")
-    m = np.array([float(r["payload_mass"]) for r in rows]) * 1e6
-    v = np.array([float(r["amplitude"]) for r in rows])
-    ok = np.array([r["returns"] == "True" for r in rows])
-    bounds = {k: b * 1e6 for k, b in column_limits().items()}
-    sim_edge = simulated_edges(m, v, ok)
-    lines = ["# Stability map: pedot-micro standing up, payload at l_e = 6.27 mm, 0.1 Hz square wave", "",
-             f"{len(rows)} points of {a.periods} periods; criterion: tip curvature changes sign in the last period "
-             "(Dadras et al. 2021: the third)" + (f"; stopped once periodic within {a.stop_when_periodic:g} (stopped_early)"
-                                        if a.stop_when_periodic else "") + ".", "",
-             "| amplitude (V) | simulated limit (mg) |", "|---|---|"]
-    lines += [f"| {amp:.3g} | {edge:.1f} |" for amp, edge in sim_edge.items()]
-    lines += ["", "| theory (amplitude independent) | mass (mg) |", "|---|---|"]
-    lines += [f"| {k} | {b:.1f} |" for k, b in bounds.items()]
-    lines += ["", "Below the relaxed column load the beam holds any amplitude; above it, the drive's own moment "
-              "pushes the column back through straight each half period, so the drive-following limit rises "
-              "with amplitude (validation: 99.7 mg at 1.5 V), up to the instantaneous column load."]
+    return ap
+
+
+def _figure(out: Path, m, v, ok, bounds: dict, lines: list) -> None:
+    """stability_map.png (the report extra), named in the report ``lines``; else the report
+    says why not."""
     try:
         import matplotlib
         matplotlib.use("Agg")
@@ -142,11 +163,11 @@ def main(argv=None):
         lines.insert(2, "![stability map](stability_map.png)\n")
     except ImportError:
         lines.append("\n(figure skipped: pip install -e '.[report]' for matplotlib)")
-    with replacing(out / "report.md", "--out (report.md)", picked=True) as tmp:
-        tmp.write_text("\n".join(lines) + "\n")
 
-    # the recording: the report beside the map as a figure (axes, units, legend); without
-    # matplotlib the report's tables alone
+
+def _recording(out: Path, m, v, ok, lines: list) -> None:
+    """stability_map.rrd: the report beside the map as a figure (axes, units, legend); without
+    matplotlib the report's tables alone."""
     import rerun as rr
     import rerun.blueprint as rrb
     figure = out / "stability_map.png"
@@ -164,5 +185,3 @@ def main(argv=None):
         table += [f"| {mm:.1f} | {vv:.3g} | {'yes' if o else 'no'} |" for mm, vv, o in zip(m, v, ok)]
         rec.log("report", rr.TextDocument("\n".join([x for x in lines if not x.startswith("![")] + table),
                                           media_type="text/markdown"), static=True)
-    print("\n".join(lines))
-    print(f"wrote {out / 'report.md'}, {out / 'stability_map.rrd'}")
