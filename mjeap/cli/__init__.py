@@ -10,8 +10,9 @@ from typing import List, Optional
 
 from ..io.commandline import run_command
 from . import actuators, identify, runs, studies
+from .actuators import describe
 
-__all__ = ["main", "build_parser"]
+__all__ = ["main", "build_parser", "describe"]
 
 #: the commands' modules, in the order ``mjeap --help`` lists them
 MODULES = (actuators, runs, studies, identify)
