@@ -44,7 +44,6 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass
 from typing import Optional, Union
 
 import mujoco
@@ -60,7 +59,11 @@ from ..model.fields import apply_dof_damping
 from ..model.mjcf import build_spec, get_builder
 from ..model.modes import modal_frequencies, stability_limit
 from ..units import DEFAULT_UNITS, UnitSystem
+from .beam_analysis import ANALYSES, BeamAnalysis, TimestepChoice, floor_sig
 from .part import ActuatorPart
+
+__all__ = ["Scene", "TimestepChoice", "as_scene", "input_files", "clear_build_caches", "diverged",
+           "warn_heavy_payload", "DEFAULT_SEGMENTS", "INTEGRATORS", "DEFAULT_MAX_BEND"]
 
 STEPS_PER_PERIOD = 50
 STABILITY_SAFETY = 0.5
@@ -93,65 +96,6 @@ def diverged(data: mujoco.MjData) -> bool:
     finite only if every entry is, and no entry is near overflow)."""
     return data.warning[mujoco.mjtWarning.mjWARN_BADQACC].number > 0 or \
         not math.isfinite(float(data.qpos.sum()) + float(data.qvel.sum()))
-
-
-def _floor_sig(x: float, digits: int) -> float:
-    e = np.floor(np.log10(x)) - (digits - 1)
-    return float(np.floor(x / 10**e * (1 + 1e-12)) * 10**e)
-
-
-@dataclass(frozen=True)
-class TimestepChoice:
-    """How the timestep and damping were chosen (SI)."""
-
-    timestep: float               # s
-    stability_limit: float        # s (inf: none)
-    accuracy_limit: float         # s, T_1 / STEPS_PER_PERIOD
-    first_frequency: float        # Hz, scene's first bending mode (gravity included; past the
-                                  # buckling load the straight column's growth rate / 2 pi)
-    highest_frequency: float      # Hz, highest discrete mode (elastic)
-    damping_ratio: float          # zeta_1
-    rayleigh_beta: float          # s, the first mode's whole stiffness-proportional damping
-    integrator_beta: float        # s, the part of it that 'discrete' adds itself (its timestep)
-    integrator: str
-    buckled: bool                 # reference configuration unstable under gravity
-    reason: str
-
-    def as_dict(self) -> dict:
-        return dict(self.__dict__)
-
-
-@dataclass(frozen=True)
-class _BeamAnalysis:
-    """What a scene's timestep and damping are chosen from, the timestep aside (internal units)."""
-
-    actuator: Actuator            # held: its id in the key stays its own while cached
-    linearization: object         # mjeap.model.modes.Linearization of the spec as built
-    w_el: float                   # first elastic mode (rad per time unit), gravity's load left out
-    wmax: float                   # highest elastic mode
-    w1: float                     # first mode's rate, gravity included (floored)
-    buckled: bool
-    pattern: np.ndarray           # Rayleigh damping per dof per unit beta
-    beta: float                   # Rayleigh beta
-    h_stab: float                 # stability limit under the integrator (inf: none)
-
-    def nbytes(self) -> int:
-        """Memory held by its matrices (bytes)."""
-        return self.pattern.nbytes + sum(getattr(self.linearization, k).nbytes
-                                         for k in ("M", "K_elastic", "K_gravity", "K_joint"))
-
-
-#: the timestep-independent analysis of a scene (linearisation, modes, Rayleigh beta and
-#: stability limit: two thirds of building one), keyed on everything that determines it,
-#: ``Scene.build_key``: the actuator object (held, so its id is not reused while cached),
-#: representation, segments, orientation, payload, units, gravity, damping ratio,
-#: integrator and max_bend. An accuracy target's models of one beam at different steps, and
-#: a sweep's points that differ only in their drive, share it. Oldest dropped past ANALYSIS_CACHE_SIZE
-#: entries or ANALYSIS_CACHE_BYTES of matrices (a 1000-segment beam's take ~30 MB)
-ANALYSIS_CACHE_SIZE = 256
-ANALYSIS_CACHE_BYTES = 64 * 2**20
-_ANALYSES = BoundedCache("beam analyses", max_entries=ANALYSIS_CACHE_SIZE, max_bytes=ANALYSIS_CACHE_BYTES,
-                         nbytes=_BeamAnalysis.nbytes, locked=True)
 
 
 #: scenes built for reuse, per thread (a scene's data is its runs' state), by everything they
@@ -273,10 +217,10 @@ class Scene:
         u = self.units
         b, hd, lay = self.builder, self.handles, self.layout
         o = self.orientation if isinstance(self.orientation, str) else self.rotation.tobytes()
-        #: everything this scene's model was built from (the actuator by identity: see _ANALYSES)
+        #: everything this scene's model was built from (the actuator by identity: see ANALYSES)
         self.build_key = key = (id(self.actuator), self.representation, lay.segments, o, self.payload, u,
                                 self._arguments["gravity"], zeta, self.integrator, self.max_bend)
-        a = _ANALYSES.get_or_build(key, lambda: self._analyse(zeta), owner=self.actuator)
+        a = ANALYSES.get_or_build(key, lambda: self._analyse(zeta), owner=self.actuator)
         self.linearization = a.linearization
         w_el, wmax, w1, buckled, beta, h_stab = a.w_el, a.wmax, a.w1, a.buckled, a.beta, a.h_stab
         kj = lay.hinge_stiffness / u.rotational_stiffness
@@ -313,7 +257,7 @@ class Scene:
             # rounded down to 3 significant figures in SI: a clean number that does not
             # depend on the internal units (the limit itself is known to ~1e-4)
             h_si = min(h_acc, STABILITY_SAFETY * h_stab) * u.time
-            h = _floor_sig(h_si, 3) / u.time
+            h = floor_sig(h_si, 3) / u.time
             reason = (f"min(T1/{STEPS_PER_PERIOD} = {T1 / STEPS_PER_PERIOD * u.time:.3g} s, "
                       f"T_el/{STEPS_PER_PERIOD} = {T_el / STEPS_PER_PERIOD * u.time:.3g} s (no gravity load), "
                       f"{STABILITY_SAFETY} x stability limit {h_stab * u.time:.3g} s"
@@ -334,7 +278,7 @@ class Scene:
         b.finish(self.spec, hd, h)
         return choice
 
-    def _analyse(self, zeta: float) -> "_BeamAnalysis":
+    def _analyse(self, zeta: float) -> "BeamAnalysis":
         """The timestep-independent part of the choice: linearisation, modes, Rayleigh beta and
         the stability limit of the spec as built (no damping yet)."""
         u = self.units
@@ -379,7 +323,7 @@ class Scene:
             bent = np.full(lay.segments, self.max_bend / lay.segments)
             h_stab = min(h_stab, stability_limit(b.linearize(model, hd, lay, u, angles=bent), dof_damping,
                                                  self.integrator, h_max=T_short))
-        return _BeamAnalysis(self.actuator, lin, w_el, wmax, w1, buckled, pattern, beta, h_stab)
+        return BeamAnalysis(self.actuator, lin, w_el, wmax, w1, buckled, pattern, beta, h_stab)
 
     def check_timestep(self, timestep: float, name: str = "timestep") -> float:
         """``timestep`` (s), refused with the limit and its reason where this beam would not
@@ -390,7 +334,7 @@ class Scene:
         u = self.units
         for limit, why in sorted(self._timestep_limits, key=lambda x: x[0]):    # the tightest named
             if h > limit * u.time * (1 + 1e-9):
-                raise ParameterError(name, timestep, f"a timestep <= {_floor_sig(limit * u.time, 4):.4g} s", why)
+                raise ParameterError(name, timestep, f"a timestep <= {floor_sig(limit * u.time, 4):.4g} s", why)
         return h
 
     def joint_damping(self, timestep: float, choice: Optional[TimestepChoice] = None) -> np.ndarray:
