@@ -1,4 +1,4 @@
-"""HAMR leg phase control from the actuator's own current (Jayaram et al. 2018, Jayaram et al. 2018,
+"""HAMR leg phase control from the actuator's own current (Jayaram et al. 2018,
 section 6.2), written against mjeap's public API only.
 
 Scene: the HAMR small bimorph (catalog residual tip mass fitted to its measured 1750 Hz) drives one

@@ -1,5 +1,5 @@
 """Self-sensing tip velocity of a piezoelectric bimorph from its own drive current
-(Jayaram et al. 2018, Jayaram et al. 2018, eqs. 7-9), written against mjeap's public API only.
+(Jayaram et al. 2018, eqs. 7-9), written against mjeap's public API only.
 
     I_sen = I_act - (2 V - V_bias) / (2 R_fit) - beta C_fit dV/dt      (eq. 7)
     v_sen = alpha I_sen                                                (eq. 9)

@@ -1,4 +1,4 @@
-"""Blocking-force drive for the PPy trilayer (Mutlu, Alici, Li 2013, Mutlu et al. 2013).
+"""Blocking-force drive for the PPy trilayer (Mutlu, Alici, Li 2013).
 
 The measured blocking force F_B(t, V) becomes a uniform internal moment
 M = (2/3) F_B L at every joint (the moment whose free beam, held at the tip, pushes with

@@ -1,4 +1,4 @@
-"""Electrostrictive terpolymer unimorph (Metello 2020, Metello 2020).
+"""Electrostrictive terpolymer unimorph (Metello 2020).
 
 Two models, chosen with ``model=``:
 

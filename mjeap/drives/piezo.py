@@ -1,4 +1,4 @@
-"""PZT-5H bending bimorph under unipolar simultaneous drive (Jayaram 2018, Jayaram et al. 2018).
+"""PZT-5H bending bimorph under unipolar simultaneous drive (Jayaram et al. 2018).
 
 A constant bias V_bias sits across the outer electrodes and the drive signal V_sig in
 [0, V_bias] on the centre layer, so the two plates see V_bias - V_sig and V_sig, and the

@@ -1,4 +1,4 @@
-"""Ionic actuator: RC charging and back-relaxation (Dadras 2021, Dadras et al. 2021, eqs. 1-8).
+"""Ionic actuator: RC charging and back-relaxation (Dadras et al. 2021, eqs. 1-8).
 
 Identified whole-actuator model (eq. 8), K curvature (1/m), V volts:
 

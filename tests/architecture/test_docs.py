@@ -95,3 +95,14 @@ def test_every_test_file_has_a_layer(request):
 @pytest.mark.parametrize("name", ["slow"])
 def test_markers_are_registered(request, name):
     assert any(m.split(":")[0].strip() == name for m in request.config.getini("markers"))
+
+
+def test_the_architecture_pages_map_is_drawn_from_the_package():
+    """docs/architecture.md's map lists every module of every floor with its docstring's
+    first line, as scripts/architecture_page.py draws it from the package."""
+    import subprocess
+    p = subprocess.run([sys.executable, str(ROOT / "scripts" / "architecture_page.py"), "--check"],
+                       capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0, "stale: run python scripts/architecture_page.py"
+    text = (ROOT / "docs" / "architecture.md").read_text()
+    assert "`mjeap.simulation.pipeline`" in text and "`mjeap.studies.optimize`" in text
