@@ -16,13 +16,15 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 
 import numpy as np
-import scipy.linalg
-from scipy import optimize
 
 from ..model.catalog import Actuator, get_actuator
 from ..errors import ParameterError, check_positive
 from ..model.modes import linearize
 from ..simulation.scene import Scene
+from ..lazy import lazy_module
+
+#: imported at its first use (mjeap.lazy)
+optimize, linalg = (lazy_module(f"scipy.{m}") for m in ("optimize", "linalg"))
 
 
 @dataclass(frozen=True)
@@ -90,7 +92,7 @@ def clamp_stiffness_for_frequency(actuator, target_frequency: float, segments: i
     def excess(log_kc):
         K = lin.K_elastic.copy()
         K[j0, j0] = 1.0 / (1.0 / k0 + np.exp(-log_kc))
-        return np.sqrt(scipy.linalg.eigh(K, lin.M, eigvals_only=True)[0]) - w_target
+        return np.sqrt(linalg.eigh(K, lin.M, eigvals_only=True)[0]) - w_target
 
     if excess(np.log(1e9 * k0)) < 0 or excess(np.log(1e-9 * k0)) > 0:
         raise ParameterError("target_frequency", target_frequency, "a frequency below the scene's first mode")

@@ -20,9 +20,12 @@ from dataclasses import dataclass, field
 from typing import Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
-from scipy import optimize
 
 from ..errors import ParameterError
+from ..lazy import lazy_module
+
+#: imported at its first use (mjeap.lazy)
+optimize = lazy_module("scipy.optimize")
 
 __all__ = ["ScaleFit", "scaled_actuator", "check_residual", "fit_tip_trajectory", "trajectory_actuator",
            "RESIDUAL_WARNING", "RESIDUAL_LIMIT"]

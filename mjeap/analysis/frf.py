@@ -29,9 +29,12 @@ from typing import Optional
 
 import mujoco
 import numpy as np
-from scipy import optimize
 
 from ..errors import ParameterError, check_integer, check_positive
+from ..lazy import lazy_module
+
+#: imported at its first use (mjeap.lazy)
+optimize = lazy_module("scipy.optimize")
 
 __all__ = ["FrequencyResponse", "SmallSignalModel", "frequency_response", "parse_frequency", "check_sweep", "sweep_limit",
            "write_frf", "plot_frf", "FRF_COLUMNS"]

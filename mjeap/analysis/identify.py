@@ -25,9 +25,12 @@ from pathlib import Path
 from typing import Dict, Optional, Sequence, Tuple, Union
 
 import numpy as np
-from scipy import optimize, signal
 
 from ..errors import ParameterError
+from ..lazy import lazy_module
+
+#: imported at its first use (mjeap.lazy)
+optimize, signal = (lazy_module(f"scipy.{m}") for m in ("optimize", "signal"))
 
 #: fewest samples accepted by the fits
 MIN_SAMPLES = 20

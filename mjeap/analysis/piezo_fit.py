@@ -35,10 +35,12 @@ from dataclasses import dataclass, field
 from typing import Dict, List, Optional, Tuple
 
 import numpy as np
-import scipy.linalg
-from scipy import optimize
 
 from ..errors import ParameterError
+from ..lazy import lazy_module
+
+#: imported at its first use (mjeap.lazy)
+optimize, linalg = (lazy_module(f"scipy.{m}") for m in ("optimize", "linalg"))
 
 __all__ = ["PiezoData", "PiezoFit", "read_stroke", "read_frf", "read_impedance", "fit_piezo", "piezo_actuator",
            "COUPLING_PARAMETER"]
@@ -152,7 +154,7 @@ class _Model:
         m.M = self.M0 + mu * self.dM
         Kel = v.get("stiffness", 1.0) * self.Kel
         m.K = Kel + self.Kg0 + mu * self.dKg
-        lam, phi = scipy.linalg.eigh(m.K, m.M)
+        lam, phi = linalg.eigh(m.K, m.M)
         w1 = np.sqrt(max(lam[0], 0.0))
         k1 = float(phi[:, 0] @ (v.get("stiffness", 1.0) * self.pattern * phi[:, 0]))
         zeta = v.get("damping_ratio", self.scene.choice.damping_ratio)

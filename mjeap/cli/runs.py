@@ -190,8 +190,8 @@ def add_parsers(sub) -> None:
     shown.add_argument("--progress", action="store_true", help="one line per 10 %% of the simulated time on stderr "
                        "(for logs and batch jobs)")
     p.set_defaults(func=cmd_rollout)
-    from ..robots import names as robot_names
-    p = sub.add_parser("robot", help=f"run a robot's experiment (mjeap.robots): {', '.join(robot_names())}",
+    p = sub.add_parser("robot", help="run a robot's experiment (mjeap.robots: gripper, hamr-leg, hamr-walk, "
+                       "robobee-wing, and any registered; a wrong name lists them)",
                        description="Run a registered robot's experiment; its options follow the name "
                                    "(mjeap robot NAME --help).")
     p.add_argument("name", help="a registered robot (mjeap.robots.names())")

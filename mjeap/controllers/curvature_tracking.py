@@ -12,7 +12,10 @@ from __future__ import annotations
 from typing import Callable, Dict
 
 import numpy as np
-from scipy import signal
+from ..lazy import lazy_module
+
+#: imported at its first use (mjeap.lazy)
+signal = lazy_module("scipy.signal")
 
 
 class CurvatureTracker:

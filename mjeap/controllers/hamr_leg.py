@@ -25,7 +25,6 @@ from dataclasses import dataclass, field
 from typing import Dict, List, Optional
 
 import numpy as np
-from scipy import optimize
 
 from mjeap.simulation.rollout import rollout
 from mjeap.simulation.scene import Scene
@@ -35,6 +34,10 @@ from mjeap.errors import ParameterError, check_positive
 from mjeap.analysis.frequency import phasor
 
 from mjeap.controllers.self_sensing import SelfSensingEstimator, calibrate_on_free_actuator
+from ..lazy import lazy_module
+
+#: imported at its first use (mjeap.lazy)
+optimize = lazy_module("scipy.optimize")
 
 ACTUATOR = "pzt-hamr-small"
 MEASURED_RESONANCE = 1750.0     # Hz, Table 1, Type II

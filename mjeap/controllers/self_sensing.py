@@ -34,10 +34,13 @@ from dataclasses import dataclass, field
 from typing import Optional
 
 import numpy as np
-from scipy import optimize
 
 from mjeap.errors import ParameterError, check_positive
 from mjeap.analysis.frequency import SineSweep
+from ..lazy import lazy_module
+
+#: imported at its first use (mjeap.lazy)
+optimize = lazy_module("scipy.optimize")
 
 
 @dataclass

@@ -17,9 +17,12 @@ from typing import ClassVar, Dict, Optional, Tuple, Type
 
 import mujoco
 import numpy as np
-from scipy import signal
 
 from ..errors import ParameterError, UnknownNameError, check_registration
+from ..lazy import lazy_module
+
+#: imported at its first use (mjeap.lazy)
+signal = lazy_module("scipy.signal")
 
 DRIVES: Dict[str, Type["Drive"]] = {}
 

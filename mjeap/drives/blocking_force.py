@@ -12,11 +12,14 @@ from __future__ import annotations
 from typing import Dict, Sequence, Tuple
 
 import numpy as np
-from scipy import signal
 
 from ..errors import ParameterError
+from ..lazy import lazy_module
 from ..model import lti
 from .base import Drive, NativeForm, OpenLoop, ExactLTI, register_drive
+
+#: imported at its first use (mjeap.lazy)
+signal = lazy_module("scipy.signal")
 
 _EST = "estimate (Mutlu et al. 2013 gives no extractable number; actuator reference: a few tenths of a mN to ~1 mN at 1 V)"
 

@@ -21,12 +21,15 @@ from typing import Dict
 
 import mujoco
 import numpy as np
-from scipy import signal
 
+from ..lazy import lazy_module
 from ..model import lti
 from ..model.analytical import DadrasModel
 from ..errors import ParameterError
 from .base import Drive, NativeForm, register_drive, zoh_first_order
+
+#: imported at its first use (mjeap.lazy)
+signal = lazy_module("scipy.signal")
 
 _SRC = "Dadras et al. 2021, eq. 8 (identified from a 3 V step)"
 _EQ8 = DadrasModel()      # the identified numbers live there, once

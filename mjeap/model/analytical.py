@@ -13,11 +13,14 @@ from dataclasses import dataclass
 from typing import Tuple
 
 import numpy as np
-from scipy import integrate, optimize, signal
 
 from ..errors import ParameterError, check_positive
+from ..lazy import lazy_module
 from . import lti
 from .section import SectionLayer, SectionProperties, multilayer_section  # noqa: F401  (re-export)
+
+#: scipy's parts, imported at their first use (:mod:`mjeap.lazy`)
+integrate, optimize, signal = (lazy_module(f"scipy.{m}") for m in ("integrate", "optimize", "signal"))
 
 __all__ = [
     "tip_force_deflection", "tip_moment_deflection", "uniform_load_deflection",

@@ -13,7 +13,11 @@ from __future__ import annotations
 import functools
 
 import numpy as np
-from scipy import signal
+
+from ..lazy import lazy_module
+
+#: imported at its first use (mjeap.lazy)
+signal = lazy_module("scipy.signal")
 
 __all__ = ["lsim"]
 

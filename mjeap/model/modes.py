@@ -12,7 +12,10 @@ from dataclasses import dataclass
 
 import mujoco
 import numpy as np
-import scipy.linalg
+from ..lazy import lazy_module
+
+#: imported at its first use (mjeap.lazy)
+linalg = lazy_module("scipy.linalg")
 
 
 @dataclass(frozen=True)
@@ -86,13 +89,13 @@ def modal_frequencies(lin: Linearization, with_gravity: bool = True) -> np.ndarr
     """Squared angular frequencies omega^2 (internal 1/time^2), ascending; negative values
     are unstable (buckled) directions."""
     K = lin.K if with_gravity else lin.K_elastic
-    return scipy.linalg.eigh(K, lin.M, eigvals_only=True)
+    return linalg.eigh(K, lin.M, eigvals_only=True)
 
 
 def _stable_part(K: np.ndarray, M: np.ndarray) -> np.ndarray:
     """K with its negative modes (physical instabilities, e.g. away from equilibrium) removed:
     those grow at any timestep and say nothing about the integrator's limit."""
-    lam, phi = scipy.linalg.eigh(K, M)
+    lam, phi = linalg.eigh(K, M)
     if lam.min() >= 0:
         return K
     Mphi = M @ phi
@@ -143,7 +146,7 @@ def stability_limit(lin: Linearization, damping: np.ndarray, integrator: str, h_
 
     if stable(h_max):
         return float("inf")
-    w2 = scipy.linalg.eigh(lin.K_elastic, lin.M, eigvals_only=True)
+    w2 = linalg.eigh(lin.K_elastic, lin.M, eigvals_only=True)
     lo = 0.5 / np.sqrt(max(w2.max(), 1e-300))
     while not stable(lo):
         lo *= 0.5

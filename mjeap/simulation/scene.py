@@ -48,7 +48,6 @@ from typing import Optional, Union
 
 import mujoco
 import numpy as np
-import scipy.linalg
 
 from .accuracy import check_accuracy
 from ..caching import BoundedCache, clear_caches
@@ -61,6 +60,10 @@ from ..model.modes import modal_frequencies, stability_limit
 from ..units import DEFAULT_UNITS, UnitSystem
 from .beam_analysis import ANALYSES, BeamAnalysis, TimestepChoice, floor_sig
 from .part import ActuatorPart
+from ..lazy import lazy_module
+
+#: imported at its first use (mjeap.lazy)
+linalg = lazy_module("scipy.linalg")
 
 __all__ = ["Scene", "TimestepChoice", "as_scene", "input_files", "clear_build_caches", "diverged",
            "warn_heavy_payload", "DEFAULT_SEGMENTS", "INTEGRATORS", "DEFAULT_MAX_BEND"]
@@ -294,7 +297,7 @@ class Scene:
                 f"(mm, mg, ms). MuJoCo said: {str(e).splitlines()[0]}") from None
         b, hd, lay = self.builder, self.handles, self.layout
         lin = b.linearize(model, hd, lay, u)
-        lam, phi = scipy.linalg.eigh(lin.K, lin.M)       # gravity included, mass-normalised
+        lam, phi = linalg.eigh(lin.K, lin.M)       # gravity included, mass-normalised
         w2_el = modal_frequencies(lin, with_gravity=False)
         buckled = bool(lam[0] <= 0)
         w_el, wmax = np.sqrt(w2_el[0]), np.sqrt(w2_el[-1])

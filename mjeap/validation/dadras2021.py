@@ -10,7 +10,6 @@ solution; its stability statement and the other column loads as comparisons.
 from __future__ import annotations
 
 import numpy as np
-from scipy import signal
 
 from ..model import analytical as an
 from ..model.discretize import Payload, clamp_rotation
@@ -18,6 +17,10 @@ from ..errors import DivergenceError
 from ..simulation.rollout import rollout
 from ..simulation.scene import Scene
 from .core import INDEPENDENT_SOLUTION, PUBLISHED_FORMULA, Experiment, experiment
+from ..lazy import lazy_module
+
+#: imported at its first use (mjeap.lazy)
+signal = lazy_module("scipy.signal")
 
 UP = clamp_rotation("up")
 EQ8 = signal.TransferFunction([63.0, 63.0 * 0.52], np.polymul([1, 0.3], [1, 1.8]))

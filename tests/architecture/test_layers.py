@@ -18,7 +18,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[2]
 #: the floors, bottom up: (name, the modules or packages on it); ``mjeap`` alone is its top level
 FLOORS = [
-    ("foundation", ("mjeap.errors", "mjeap.units", "mjeap.versions", "mjeap.caching")),
+    ("foundation", ("mjeap.errors", "mjeap.units", "mjeap.versions", "mjeap.caching", "mjeap.lazy")),
     ("io", ("mjeap.io",)),
     ("model", ("mjeap.model",)),
     ("drives", ("mjeap.drives",)),

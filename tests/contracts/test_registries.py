@@ -17,7 +17,7 @@ from mjeap.engines.loop import LoopEngine
 from mjeap.errors import ParameterError
 from mjeap.model.mjcf import BUILDERS, HingeChainBuilder
 from mjeap.robots import Robot
-from mjeap.robots.registry import _REGISTRY as ROBOTS
+from mjeap.robots.registry import REGISTRY as ROBOTS
 from mjeap.simulation.system import System, attach
 from mjeap.studies.sweep import METRICS, evaluate, register_metric
 

@@ -42,3 +42,13 @@ def test_mjeap_robot_passes_its_options_to_the_experiment(capsys):
     with pytest.raises(SystemExit) as e:
         main(["robot", "robobee-wing", "--help"])
     assert e.value.code == 0 and "--quick" in capsys.readouterr().out
+
+
+def test_the_robot_commands_help_names_every_registered_robot():
+    """The help of ``mjeap robot`` names the robots without importing them (a cold ``mjeap
+    show`` would pay for their SciPy and MjSpec code): the text must follow the registry."""
+    from mjeap.cli import build_parser
+    from mjeap.robots import names
+    sub = build_parser()._subparsers._group_actions[0]
+    text = next(a.help for a in sub._choices_actions if a.dest == "robot")
+    assert all(n in text for n in names()), (names(), text)

@@ -31,7 +31,6 @@ from pathlib import Path
 from typing import Optional
 
 import numpy as np
-from scipy import optimize
 
 from ...errors import ParameterError, check_range
 from ...io.commandline import arg_number, arg_output, parse_args
@@ -41,6 +40,10 @@ from ...simulation.system import System
 from ...studies.sweep import stop_workers, worker_signals
 from ..registry import summary
 from .model import A, BEAD_MASS, BEAD_RADIUS, G, GAP, MU, MU_TORSION, build
+from ...lazy import lazy_module
+
+#: imported at its first use (mjeap.lazy)
+optimize = lazy_module("scipy.optimize")
 
 LIFT = 1e-3                   # m, how far the base rises
 LIFT_TIME = 0.5               # s, over which it rises (constant speed)

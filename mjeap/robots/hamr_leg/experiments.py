@@ -24,7 +24,6 @@ import argparse
 import json
 
 import numpy as np
-from scipy import optimize
 
 from ...analysis.frequency import phasor
 from ...controllers.hamr_leg import (LegPhaseController, cycles_to_within, free_estimator, phase_errors_per_cycle,
@@ -35,6 +34,10 @@ from ...io.outputs import run_guard
 from ...simulation.system import System
 from ..registry import summary
 from .model import BIAS, DOFS, FOOT_COORD, LEG_LENGTH, ZETA, build, design, foot
+from ...lazy import lazy_module
+
+#: imported at its first use (mjeap.lazy)
+optimize = lazy_module("scipy.optimize")
 
 AMPLITUDE, FREQUENCY = 20.0, 100.0            # V (40 Vpp), Hz
 SWEEP = np.array([40, 50, 60, 70, 75, 80, 85, 90, 95, 100, 105, 110, 120, 130, 140.0])   # Hz, Fig. 8(a)-(b)
