@@ -11,7 +11,7 @@ import hashlib
 import os
 import warnings
 from pathlib import Path
-from typing import Dict
+from typing import Dict, Optional
 
 from ..caching import BoundedCache
 from ..errors import ParameterError, UnknownNameError
@@ -55,11 +55,48 @@ PVDF_60, PVDF_60_HALF, PVDF_130 = CATALOG["pvdf-60"], CATALOG["pvdf-60-half"], C
 PZT_HAMR_LARGE, PZT_HAMR_SMALL, PZT_ROBOBEE = CATALOG["pzt-hamr-large"], CATALOG["pzt-hamr-small"], CATALOG["pzt-robobee"]
 
 
+class ActuatorRef(str):
+    """An actuator a study resolved once, at its edge: the name it was given (a catalog id or
+    an actuator file's path; the text its points, their ids and its CSV carry, as before) and
+    the :class:`Actuator` itself (``actuator``), with the SHA-1 of the file's bytes
+    (``digest``, hex; None for a catalog id). Wherever an actuator is taken by name
+    (:func:`get_actuator`) the object is used and the file is never read again; a point sent
+    to a worker process carries it (pickled whole)."""
+
+    def __new__(cls, name: str, actuator: Actuator, digest: Optional[str] = None):
+        ref = str.__new__(cls, name)
+        ref.actuator, ref.digest = actuator, digest
+        return ref
+
+    def __reduce__(self):
+        return ActuatorRef, (str(self), self.actuator, self.digest)
+
+
+def resolve_actuator(name):
+    """``name`` (a catalog id or an actuator file's path) resolved once: an
+    :class:`ActuatorRef` carrying the Actuator (an ActuatorRef or an Actuator itself is
+    returned as it is). A file is read once here (its bytes for the digest and the object
+    from them: the same object :func:`get_actuator` gives for the same content)."""
+    if isinstance(name, (ActuatorRef, Actuator)) or not isinstance(name, (str, Path)):
+        return name
+    if is_actuator_file(name):
+        p = Path(name)
+        try:
+            data = p.read_bytes() if p.is_file() else None
+        except OSError:
+            data = None
+        act = file_actuator(str(name), data)     # refused here, naming the file, where it is not one
+        return ActuatorRef(str(name), act, None if data is None else hashlib.sha1(data).hexdigest())
+    return ActuatorRef(str(name), get_actuator(name))
+
+
 def get_actuator(name) -> Actuator:
     """An actuator by catalog id or from an actuator file: a name that ends in ``.toml`` or
     holds a path separator is a file (:meth:`Actuator.from_file`), anything else a catalog
     id (an unknown id raises with the closest ids suggested); a catalog id that is also an
     existing file here is refused naming both."""
+    if isinstance(name, ActuatorRef):
+        return name.actuator
     if isinstance(name, Actuator):
         return validate_actuator(name)
     if is_actuator_file(name):
@@ -83,15 +120,17 @@ def get_actuator(name) -> Actuator:
 _FILES = BoundedCache("actuator files", max_entries=64, locked=True)
 
 
-def file_actuator(path) -> Actuator:
+def file_actuator(path, data: Optional[bytes] = None) -> Actuator:
     """The Actuator of the actuator file ``path`` (:func:`read_actuator`), one object per
     file content: read again, an unchanged file gives the object it gave before (and the
-    warnings its reading gave, again); a changed one is read anew."""
+    warnings its reading gave, again); a changed one is read anew. ``data``: the file's bytes
+    where the caller has read them already."""
     p = Path(path)
-    try:
-        data = p.read_bytes() if p.is_file() else None
-    except OSError:
-        data = None
+    if data is None:
+        try:
+            data = p.read_bytes() if p.is_file() else None
+        except OSError:
+            data = None
     if data is None:                    # read_actuator says what is wrong with it
         return read_actuator(path)
     key = (str(path), os.path.realpath(p), hashlib.blake2b(data, digest_size=16).digest())
@@ -108,9 +147,11 @@ def file_actuator(path) -> Actuator:
 
 
 def check_actuator_files(names) -> None:
-    """Read every actuator file among ``names`` once (catalog ids and Actuators pass): a bad
-    file raises, naming the file, the key and what is accepted, before any work (a sweep's)."""
-    for n in dict.fromkeys(n for n in names if isinstance(n, (str, Path)) and is_actuator_file(n)):
+    """Read every actuator file among ``names`` once (catalog ids, Actuators and the
+    :class:`ActuatorRef` of a study pass): a bad file raises, naming the file, the key and what
+    is accepted, before any work (a sweep's)."""
+    for n in dict.fromkeys(n for n in names if isinstance(n, (str, Path)) and not isinstance(n, ActuatorRef)
+                           and is_actuator_file(n)):
         read_actuator(n)
 
 

@@ -159,11 +159,15 @@ class OptimizeResult:
 
 
 def _base_actuator(actuator, folder: Optional[Path]):
-    """The study's ``actuator`` setting: a catalog id or a file's path as given; an Actuator
-    object is written as an actuator file (in the output folder, else a temporary one)."""
+    """The study's ``actuator`` setting, resolved once at its edge (an
+    :class:`~mjeap.model.catalog.ActuatorRef`: its points never read a file again): a catalog
+    id or a file's path as given; an Actuator object is written as an actuator file (in the
+    output folder, else a temporary one: the record of the base its points name) and resolved
+    from it. Returns (the setting, the temporary folder or None)."""
     from ..model.actuator import Actuator
+    from ..model.catalog import resolve_actuator
     if isinstance(actuator, Path):
-        return str(actuator), None
+        return resolve_actuator(str(actuator)), None
     if isinstance(actuator, Actuator):
         from ..model.actuator_file import actuator_toml, write_actuator
         tmp = None
@@ -178,10 +182,10 @@ def _base_actuator(actuator, folder: Optional[Path]):
                                  "folder or remove it")
         if not path.is_file():
             write_actuator(actuator, path)
-        return str(path), tmp
+        return resolve_actuator(str(path)), tmp
     if not isinstance(actuator, str):
         raise ParameterError("actuator", actuator, "a catalog id, an actuator file's path or an Actuator")
-    return actuator, None
+    return resolve_actuator(actuator), None
 
 
 def _wave_settings(voltage) -> dict:

@@ -144,3 +144,47 @@ def test_an_out_folder_that_is_a_file_is_refused(bimorph, tmp_path, capsys):
     assert main(["optimize", bimorph, "--vary", "actuator.length=5mm:15mm", "--maximize", "mass",
                  "--out", str(tmp_path / "o")]) == 2
     assert "it is a file" in capsys.readouterr().err and (tmp_path / "o").read_text() == "mine"
+
+
+def test_an_optimisations_actuator_is_read_once_at_its_edge(tmp_path, monkeypatch):
+    """The trace of an optimisation's actuator (issue 44): resolved once at the study's edge
+    (one read of the file's bytes, one parse), then carried down as an object by every
+    evaluation, its scene, variants and point ids: the file is never read again, and every
+    evaluation's scene is built from that one Actuator object."""
+    import pathlib
+    import pickle
+    from mjeap.model import catalog
+    from mjeap.model.catalog import ActuatorRef
+    from mjeap.simulation import scene as scene_module
+    f = tmp_path / "bimorph.toml"
+    f.write_text(BIMORPH)
+    reads, parses, built = [], [], []
+    real_bytes, real_read, real_init = pathlib.Path.read_bytes, catalog.read_actuator, scene_module.Scene.__init__
+
+    def read_bytes(self):
+        if self.name == f.name:
+            reads.append(str(self))
+        return real_bytes(self)
+
+    def read_actuator(path):
+        parses.append(str(path))
+        return real_read(path)
+
+    def init(self, actuator, **kw):
+        built.append(actuator)
+        real_init(self, actuator, **kw)
+    monkeypatch.setattr(pathlib.Path, "read_bytes", read_bytes)
+    monkeypatch.setattr(catalog, "read_actuator", read_actuator)
+    monkeypatch.setattr(scene_module.Scene, "__init__", init)
+    from mjeap.caching import clear_caches
+    clear_caches()                          # a cold start: the file parsed here, at the edge
+    r = mjeap.optimize(str(f), {"actuator.length": ("5mm", "15mm")}, maximize="first_frequency",
+                       max_evaluations=8, progress=False)
+    assert r.evaluations >= 3
+    assert len(reads) == 1 and len(parses) == 1, (reads, parses)     # the edge's one read and one parse
+    bases = {id(a) for a in built if getattr(a, "source_file", None) == str(f)}
+    assert len(bases) <= 1                  # the base object, where a scene was built from it unchanged
+    ref = catalog.resolve_actuator(str(f))
+    assert isinstance(ref, ActuatorRef) and str(ref) == str(f) and ref.actuator is catalog.get_actuator(ref)
+    back = pickle.loads(pickle.dumps(ref))          # what a worker process receives
+    assert isinstance(back, ActuatorRef) and back == ref and back.actuator == ref.actuator

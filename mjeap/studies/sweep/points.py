@@ -106,6 +106,9 @@ def _actuator_file_digest(actuator) -> Optional[str]:
     """SHA-1 of an actuator file's bytes (None: a catalog id, an Actuator or no such file),
     so that a point of an edited file is computed again; cached by path, size and mtime."""
     from ...model.actuator_file import is_actuator_file
+    from ...model.catalog import ActuatorRef
+    if isinstance(actuator, ActuatorRef):           # resolved at the study's edge: its digest, no read
+        return None if actuator.digest is None else actuator.digest[:16]
     if not isinstance(actuator, (str, Path)) or not is_actuator_file(actuator):
         return None
     try:
@@ -119,6 +122,27 @@ def _actuator_file_digest(actuator) -> Optional[str]:
         except OSError:
             return None
     return _FILE_DIGESTS[k]
+
+
+def resolve_actuators(points: Sequence[dict], base: Optional[dict]):
+    """(points, base) with every ``actuator`` resolved once (:func:`mjeap.model.catalog.resolve_actuator`:
+    the name kept, the Actuator carried): each file is read here, once, and never again by the
+    points, their scenes, variants or ids, in this process or a worker's. An actuator that
+    does not resolve (an unknown id) stays as given: the checks or its points report it."""
+    from ...model.catalog import resolve_actuator
+    done: Dict[object, object] = {}
+
+    def resolved(name):
+        key = name if isinstance(name, (str, Path)) else id(name)
+        if key not in done:
+            try:
+                done[key] = resolve_actuator(name)
+            except MjeapError:
+                done[key] = name
+        return done[key]
+    if base is not None and "actuator" in base:
+        base = {**base, "actuator": resolved(base["actuator"])}
+    return [{**p, "actuator": resolved(p["actuator"])} if "actuator" in p else p for p in points], base
 
 
 def check_settings(points: Sequence[dict], base: Optional[dict]) -> None:

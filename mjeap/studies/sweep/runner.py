@@ -32,8 +32,8 @@ from ...io.outputs import check_outputs, hold, output_kind
 from ..store import RowFile, drop_torn_row, read_study_csv
 from ...model.laminate import FieldWarning
 from . import metrics as _metrics      # its registries, read where a point runs
-from .points import (PARAMETERS, check_names, point_duration, point_scene, wave_text, check_design_size, check_settings,
-                     point_id, settings)
+from .points import (PARAMETERS, check_design_size, check_names, check_settings, point_duration, point_id, point_scene,
+                     resolve_actuators, settings, wave_text)
 from .metrics import check_metric_settings, metric_value
 
 EXECUTORS = ("processes", "serial", "dask")
@@ -440,6 +440,7 @@ def run_sweep(points: Sequence[dict], path, *, metrics: Sequence[str] = ("peak_t
         raise UnknownNameError("metric", unknown[0], _metrics.METRICS)
     points = list(points)
     check_design_size(len(points), "points")
+    points, base = resolve_actuators(points, base)      # the study's edge: each actuator read once
     for p in points:
         check_names(p)
     if isinstance(record, (str, bytes, int)):
