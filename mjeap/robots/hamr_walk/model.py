@@ -67,6 +67,8 @@ from ...simulation.system import ContactParameters, System, attach
 from ..hamr_leg.model import ACTUATOR, LEG_LENGTH, add_leg, design
 
 TOTAL_MASS = 1.43e-3            # kg, Jayaram et al. 2018
+PAPER_SPEED, PAPER_FREQUENCY = 0.5, 65.0      # m/s at Hz, Jayaram et al. 2018 ("approximately 0.5 m/s ... 65 Hz")
+PAPER_INCLINE = 22.0                          # deg, Jayaram et al. 2018 ("inclines nearing 22 deg")
 BODY_LENGTH = 45.1e-3           # m, Jayaram et al. 2018
 BODY_WIDTH = 15e-3              # m, assumed
 BODY_HEIGHT = 4e-3              # m, assumed
