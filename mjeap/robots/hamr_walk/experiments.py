@@ -40,9 +40,6 @@ from .model import (BIAS, FREQUENCY_RANGE, LEGS, MU, PAPER_INCLINE, SEGMENTS, Gr
 from .recording import write_recording
 
 AMPLITUDE = 0.5 * BIAS          # V, full amplitude: the signal swings 0..V_bias
-#: V: a lift amplitude at which the full-swing 65 Hz trot stays upright (hamr_walk.study: 20 and
-#: 30 V upright, 40 V and full roll over), run beside the full drive where that rolls over
-LIMITED_LIFT = 20.0
 FREQUENCIES = (5.0, 10.0, 20.0, 40.0, 65.0, 80.0, 100.0)
 RECORD_FREQUENCY = 10.0                       # Hz: the recorded run (at full amplitude it trots upright there)
 SETTLE = 0.1                    # s at least, and SETTLE_CYCLES cycles, before measuring
@@ -68,6 +65,32 @@ class SoftStart:
         t = np.asarray(t, dtype=float)
         off = self.wave.offset
         return off + np.clip(t / self.ramp, 0.0, 1.0) * (self.wave(t) - off)
+
+
+def no_flight_lift(system: System, frequency: float, amplitude: float = AMPLITUDE) -> float:
+    """The lift amplitude (V, at most ``amplitude``) at which a trot's stance pair cannot throw
+    the body off the ground at ``frequency`` (Hz): the pair's legs carry the weight W on the
+    lift actuators' stiffness (k_tip / T_lift^2 at each foot, the static sag W T^2 / (2 k_tip)
+    on two legs), and driving their feet down by A adds 2 k_tip A / T^2; for A beyond the sag
+    the pair's force swings from 2 W to below zero and the body flies. A = the sag is the lift
+    drive whose blocked force at the feet, 2 F_b' V / T_lift (F_b' the actuator's blocked force
+    per volt, :meth:`~mjeap.model.laminate.Laminate.free_deflection` / tip compliance), equals
+    W, amplified by the lift transmission's second-order gain |H(f)| (80 Hz, hamr_leg.ZETA):
+    V = W T_lift / (2 F_b' |H(f)|) (23.7 V quasi-static; 8.2 V at 65 Hz). N. Doshi's Vicon
+    measurement of HAMR-VI set down from the air (HarvardAgileRoboticsLab/drake,
+    SystemIDJbrn.m, 2018-05-17) puts the robot's legs' sag at 0.5-0.7 mm on four legs, about
+    1.0-1.4 mm on a diagonal pair, against this model's 0.77 mm."""
+    frequency = check_range("frequency", frequency, *FREQUENCY_RANGE, "Hz")
+    drv = system.actuators[0].drive
+    lam = drv.laminate()
+    lo, hi = drv.voltage_range()
+    blocked_per_volt = (lam.free_deflection(hi) - lam.free_deflection(lo)) / (hi - lo) / lam.tip_compliance()
+    m = system.model
+    weight = float(m.body_subtreemass[m.body("body").id] * np.linalg.norm(m.opt.gravity)) * system.units.force
+    tr = hamr_leg.DOFS["lift"]
+    r = frequency / tr.resonance
+    gain = 1.0 / np.hypot(1.0 - r * r, 2.0 * hamr_leg.ZETA * r)
+    return float(min(amplitude, weight * tr.ratio / (2.0 * blocked_per_volt * gain)))
 
 
 def trot_voltages(frequency: float, amplitude: float = AMPLITUDE, bias: float = BIAS,

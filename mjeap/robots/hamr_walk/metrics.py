@@ -108,6 +108,8 @@ def walk_metrics(run: dict) -> dict:
         "loaded_step_fraction": float(loaded.sum() / (4 * steps.sum())),        # every step with a load
         "contact_duty_factor_sampled": float(touch_now.mean()),                  # at the samples alone
         "contact_touchdowns_per_cycle": float(((~touch[:-1]) & touch[1:]).sum() / 4 / (duration * f)),
+        # the issue's: the onsets of a positive normal force at the samples' instants, per foot and cycle
+        "contact_touchdowns_per_cycle_sampled": float(((~touch_now[:-1]) & touch_now[1:]).sum() / 4 / (duration * f)),
         "contact_when_near": float(touch[near].mean()) if near.any() else None,
         "contact_when_near_sampled": float(touch_now[1:][near].mean()) if near.any() else None,
         # the load's onsets at the step's resolution (a flickering contact: many per cycle)

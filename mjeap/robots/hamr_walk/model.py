@@ -100,10 +100,11 @@ CONTACT_SENSOR = [2, 3, 1]
 LEGS = {"FL": (1, 1, 0.0), "FR": (1, -1, np.pi), "RL": (-1, 1, np.pi), "RR": (-1, -1, 0.0)}
 
 
-def build(mu: float = MU, segments: int = SEGMENTS, bias: float = BIAS, incline_deg: float = 0.0,
+def build(mu: float = MU, segments: int = SEGMENTS, *, bias: float = BIAS, incline_deg: float = 0.0,
           d: Optional[dict] = None, armature_fraction: float = 0.0, foot_drop: float = FOOT_DROP,
           body_width: float = BODY_WIDTH, timeconst_steps: float = CONTACT_STEPS,
-          upside_down: bool = False, integrator: str = INTEGRATOR, actuator_range: float = ACTUATOR_RANGE) -> System:
+          upside_down: bool = False, integrator: str = INTEGRATOR, actuator_range: float = ACTUATOR_RANGE,
+          timestep: Optional[float] = None) -> System:
     """The robot as a System (host in mm, mg, ms) standing on a ground plane tilted by
     ``incline_deg`` about y (uphill along +x); ``d``: hamr_leg.design() (computed if None).
 
@@ -120,7 +121,11 @@ def build(mu: float = MU, segments: int = SEGMENTS, bias: float = BIAS, incline_
     ground (the rolled-over robot). ``integrator``: the actuators' ('discrete', INTEGRATOR:
     the feet's contacts reach the beams through the transmissions, see the module text).
     ``actuator_range`` (m): each actuator's tip travel either way (ACTUATOR_RANGE, a stop as
-    stiff as the ground contact)."""
+    stiff as the ground contact). ``timestep`` (s): None, the actuators' own step (beta / 2 of
+    the free beam, 4.51 us at 4 segments); a larger one is sized for the loaded system
+    (:func:`loaded_timestep`, System's ``loaded``): the contact keeps its time constant in
+    seconds (at least 2 steps, MuJoCo's floor) and the legs' joint damping gives back what the
+    step's own damping h K adds to the transmissions' modes (:func:`leg_damping_at_step`)."""
     mu = check_range("mu", mu, 0.0, 10.0)
     segments = check_integer("segments", segments, 1, 40)
     incline = np.radians(check_range("incline_deg", incline_deg, -45.0, 45.0, "deg"))
@@ -202,14 +207,44 @@ def build(mu: float = MU, segments: int = SEGMENTS, bias: float = BIAS, incline_
     box.mass = own
     acts_list = list(acts.values())
     u = acts_list[0].twin.units
-    h = min(a.twin.timestep for a in acts_list)
-    contact = contact_parameters(h, mu, timeconst_steps)
+    h0 = min(a.twin.timestep for a in acts_list)         # the actuators' own step: the contact is sized on it
+    h = h0 if timestep is None else check_range("timestep", timestep, 0.0, MAX_TIMESTEP, "s", lo_open=True)
+    tau = max(timeconst_steps * h0, 2.0 * h)              # s: the contact's time constant, MuJoCo's floor 2 h
+    contact = contact_parameters(h, mu, tau / h)
     # System applies contact parameters only for actuators with contact: here the feet's
     contact.apply(spec, h / u.time, FOOT_RADIUS / u.length, u.length)
     spec.option.tolerance = SOLVER_TOLERANCE
     for a in acts_list:             # the stops as stiff as the ground contact (its time constant)
-        spec.tendon(a.name("tip_deflection")).solref_limit = [timeconst_steps * h / u.time, 1.0]
-    return System(spec, acts_list, contact=contact)
+        spec.tendon(a.name("tip_deflection")).solref_limit = [tau / u.time, 1.0]
+    if timestep is None:
+        return System(spec, acts_list, contact=contact)
+    beta = acts_list[0].twin.choice.rayleigh_beta
+    for leg in LEGS:                # the step damps the transmissions by h K: the legs carry the rest of ZETA
+        for dof, c in leg_damping_at_step(d, h, beta).items():
+            spec.joint(f"{leg}/{dof}").damping = [c / (u.mass * u.length ** 2 / u.time), 0.0, 0.0]
+    return System(spec, acts_list, timestep=h, contact=contact, loaded=True)
+
+
+#: s, the largest step :func:`build` takes: 1/50 of the period of the fastest transmission mode (100 Hz)
+MAX_TIMESTEP = 2e-4
+
+
+def leg_damping_at_step(d: dict, h: float, beta: float) -> dict:
+    """Per degree of freedom the leg joint's damping (N m s) that keeps each transmission mode
+    at hamr_leg.ZETA when the system steps at ``h`` (s): under 'discrete' the beam's hinges are
+    damped by max(beta, h) K (their Rayleigh beta, or the step's own h K where that is larger),
+    which damps the loaded mode at omega by max(beta, h) omega / 2; the joint carries the rest,
+    2 (ZETA - max(beta, h) omega / 2) omega I (hamr_leg.design: the same with beta)."""
+    from ..hamr_leg.model import DOFS, ZETA
+    out = {}
+    for dof, tr in DOFS.items():
+        w = 2 * np.pi * tr.resonance
+        share = 0.5 * max(beta, h) * w
+        if share >= ZETA:
+            raise ParameterError("timestep", h, f"a step whose own damping h omega / 2 stays below ZETA = {ZETA:g} "
+                                 f"at the {dof} resonance ({tr.resonance:g} Hz): h < {2 * ZETA / w:.3g} s")
+        out[dof] = 2 * (ZETA - share) * w * d[dof]["joint_inertia_kg_m2"]
+    return out
 
 
 def contact_parameters(h: float, mu: float = MU, timeconst_steps: float = CONTACT_STEPS) -> ContactParameters:
