@@ -34,7 +34,7 @@ from ...errors import check_integer, check_range
 from ...simulation.system import System
 from .. import hamr_leg
 from .metrics import walk_metrics
-from .model import (BIAS, FREQUENCY_RANGE, LEGS, MU, PAPER_INCLINE, SEGMENTS, GroundImpulses, body_position,
+from .model import (ACTUATOR_RANGE, BIAS, FREQUENCY_RANGE, LEGS, MU, PAPER_INCLINE, SEGMENTS, GroundImpulses, body_position,
                     body_rotation, build, clearances, design, feet, foot_forces, ground_force, ground_rotation,
                     metering)
 from .recording import write_recording
@@ -67,6 +67,22 @@ class SoftStart:
         return off + np.clip(t / self.ramp, 0.0, 1.0) * (self.wave(t) - off)
 
 
+def _transmission(system: System, dof: str, frequency: float) -> tuple:
+    """(the foot's quasi-static stroke per volt (m/V), the actuator's blocked force per volt (N/V),
+    the transmission's second-order gain |H(f)| at ``frequency``, its ratio) of one leg degree
+    of freedom: the laminate's free deflection and tip compliance (the drive's closed forms),
+    the transmission's resonance (hamr_leg.DOFS) and damping ratio (hamr_leg.ZETA)."""
+    frequency = check_range("frequency", frequency, *FREQUENCY_RANGE, "Hz")
+    drv = system.actuators[0].drive
+    lam = drv.laminate()
+    lo, hi = drv.voltage_range()
+    free_per_volt = (lam.free_deflection(hi) - lam.free_deflection(lo)) / (hi - lo)
+    tr = hamr_leg.DOFS[dof]
+    r = frequency / tr.resonance
+    return free_per_volt, free_per_volt / lam.tip_compliance(), 1.0 / np.hypot(1.0 - r * r, 2.0 * hamr_leg.ZETA * r), \
+        tr.ratio
+
+
 def no_flight_lift(system: System, frequency: float, amplitude: float = AMPLITUDE) -> float:
     """The lift amplitude (V, at most ``amplitude``) at which a trot's stance pair cannot throw
     the body off the ground at ``frequency`` (Hz): the pair's legs carry the weight W on the
@@ -74,23 +90,37 @@ def no_flight_lift(system: System, frequency: float, amplitude: float = AMPLITUD
     on two legs), and driving their feet down by A adds 2 k_tip A / T^2; for A beyond the sag
     the pair's force swings from 2 W to below zero and the body flies. A = the sag is the lift
     drive whose blocked force at the feet, 2 F_b' V / T_lift (F_b' the actuator's blocked force
-    per volt, :meth:`~mjeap.model.laminate.Laminate.free_deflection` / tip compliance), equals
-    W, amplified by the lift transmission's second-order gain |H(f)| (80 Hz, hamr_leg.ZETA):
-    V = W T_lift / (2 F_b' |H(f)|) (23.7 V quasi-static; 8.2 V at 65 Hz). N. Doshi's Vicon
-    measurement of HAMR-VI set down from the air (HarvardAgileRoboticsLab/drake,
-    SystemIDJbrn.m, 2018-05-17) puts the robot's legs' sag at 0.5-0.7 mm on four legs, about
-    1.0-1.4 mm on a diagonal pair, against this model's 0.77 mm."""
-    frequency = check_range("frequency", frequency, *FREQUENCY_RANGE, "Hz")
-    drv = system.actuators[0].drive
-    lam = drv.laminate()
-    lo, hi = drv.voltage_range()
-    blocked_per_volt = (lam.free_deflection(hi) - lam.free_deflection(lo)) / (hi - lo) / lam.tip_compliance()
+    per volt: the laminate's free deflection / tip compliance), equals W, amplified by the lift
+    transmission's second-order gain |H(f)| (80 Hz, hamr_leg.ZETA): V = W T_lift / (2 F_b'
+    |H(f)|) (23.3 V at 10 Hz, 8.3 V at 65 Hz). N. Doshi's Vicon measurement of HAMR-VI set down
+    from the air (HarvardAgileRoboticsLab/drake, GaitRecoveryTransition/SystemIDJbrn.m,
+    2018-05-17) puts the robot's legs' sag at 0.5-0.7 mm on four legs (about 1.0-1.4 mm on a
+    diagonal pair), against this model's 0.77 mm on two."""
+    _, blocked_per_volt, gain, ratio = _transmission(system, "lift", frequency)
     m = system.model
     weight = float(m.body_subtreemass[m.body("body").id] * np.linalg.norm(m.opt.gravity)) * system.units.force
-    tr = hamr_leg.DOFS["lift"]
-    r = frequency / tr.resonance
-    gain = 1.0 / np.hypot(1.0 - r * r, 2.0 * hamr_leg.ZETA * r)
-    return float(min(amplitude, weight * tr.ratio / (2.0 * blocked_per_volt * gain)))
+    return float(min(amplitude, weight * ratio / (2.0 * blocked_per_volt * gain)))
+
+
+def travel_amplitude(system: System, dof: str, frequency: float, travel: float = ACTUATOR_RANGE) -> float:
+    """The drive amplitude (V) at which the ``dof`` actuator's tip reaches its ``travel`` (m,
+    ACTUATOR_RANGE: the range of HAMR-VI's actuator joints in Doshi's model) at ``frequency``
+    (Hz): travel / (free deflection per volt x |H(f)|). At 65 Hz the swing (100 Hz) takes
+    64 V, the lift (80 Hz) 39 V; below 20 Hz both take the full 100 V."""
+    free_per_volt, _, gain, _ = _transmission(system, dof, frequency)
+    return float(travel / (free_per_volt * gain))
+
+
+def trot_drive(system: System, frequency: float, amplitude: float = AMPLITUDE) -> dict:
+    """The robot's trot at ``frequency`` (Hz), as :func:`walk`'s ``amplitude`` and
+    ``lift_amplitude`` (V): the swing at ``amplitude`` (the full drive) or, where that would
+    carry its actuator past its travel, the amplitude that reaches it
+    (:func:`travel_amplitude`); the lift at :func:`no_flight_lift`, the largest at which the
+    stance pair cannot throw the body."""
+    amplitude = check_range("amplitude", amplitude, 0.0, AMPLITUDE, "V", lo_open=True)
+    return {"amplitude": min(amplitude, travel_amplitude(system, "swing", frequency)),
+            "lift_amplitude": min(no_flight_lift(system, frequency, amplitude),
+                                  travel_amplitude(system, "lift", frequency))}
 
 
 def trot_voltages(frequency: float, amplitude: float = AMPLITUDE, bias: float = BIAS,

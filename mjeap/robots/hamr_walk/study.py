@@ -69,6 +69,8 @@ import numpy as np
 
 from ...errors import ParameterError
 from . import experiments as hw
+from .metrics import UPRIGHT_DEG
+from .model import PAPER_FREQUENCY
 from . import model
 
 #: (label, build options, walk options): one parameter changed per row
@@ -87,14 +89,14 @@ VARIANTS = (
 )
 
 
-def study_run(frequency: float = hw.PAPER_FREQUENCY, build: Optional[dict] = None, walk: Optional[dict] = None,
+def study_run(frequency: float = PAPER_FREQUENCY, build: Optional[dict] = None, walk: Optional[dict] = None,
               d: Optional[dict] = None, **walk_kw) -> dict:
     """One trot: hamr_walk.build(**build) walked at ``frequency`` (walk options ``walk``);
     its walk_metrics."""
     return hw.walk_metrics(hw.walk(model.build(d=d, **(build or {})), frequency, **(walk or {}), **walk_kw))
 
 
-def rolling_study(variants: Sequence = VARIANTS, frequency: float = hw.PAPER_FREQUENCY) -> list:
+def rolling_study(variants: Sequence = VARIANTS, frequency: float = PAPER_FREQUENCY) -> list:
     """Each of ``variants`` ((label, build options, walk options)) at ``frequency``: label,
     upright, speed (m/s), max |roll| and |pitch| (deg), the body's height range (m)."""
     if not len(variants):
@@ -245,7 +247,7 @@ def gait_study(frequencies: Sequence[float] = GAIT_FREQUENCIES, amplitudes: Sequ
             rp = np.degrees(np.abs(np.array([model.roll_pitch(R, run["ground"]) for R in run["R"]])))
             row = {"frequency_hz": float(f), "amplitude_v": float(a), "speed_m_s": m["speed_m_s"],
                    "mm_per_cycle": m["speed_m_s"] / f * 1e3,
-                   "upright_whole_run": bool(rp.max() < hw.UPRIGHT_DEG),
+                   "upright_whole_run": bool(rp.max() < UPRIGHT_DEG),
                    "max_abs_roll_deg_whole_run": float(rp[:, 0].max()),
                    "max_abs_pitch_deg_whole_run": float(rp[:, 1].max()),
                    "body_height_max_m": m["body_height_range_m"][1], "wall_s": m["wall_time_s"],
@@ -282,7 +284,7 @@ def gait_figure(rows: Sequence[dict], path) -> None:
                 ax.plot(f[up], y[up], "o", color=colours[a], label=f"mjeap, {a:g} V ({kind}): upright")
             if (~up).any():
                 ax.plot(f[~up], y[~up], "o", mfc="none", color=colours[a],
-                        label=f"mjeap, {a:g} V ({kind}): tilted past {hw.UPRIGHT_DEG:g} deg")
+                        label=f"mjeap, {a:g} V ({kind}): tilted past {UPRIGHT_DEG:g} deg")
         ax.axhline(0.0, color="0.6", lw=0.8)
         ax.set_xlabel("stride frequency (Hz)")
         ax.set_ylabel(f"forward speed ({unit})")
