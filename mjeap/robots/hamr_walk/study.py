@@ -82,7 +82,7 @@ VARIANTS = (
     ("mu 1.0", {"mu": 1.0}, {}),
     ("no shank (foot_drop 0)", {"foot_drop": 0.0}, {}),
     ("body 30 mm wide", {"body_width": 0.03}, {}),
-    ("contact 5x softer (timeconst_steps 50)", {"timeconst_steps": 50.0}, {}),
+    ("contact 2.2x softer (timeconst_steps 50)", {"timeconst_steps": 50.0}, {}),
     ("lift 20 V", {}, {"lift_amplitude": 20.0}),
     ("lift 30 V", {}, {"lift_amplitude": 30.0}),
     ("lift 50 V", {}, {"lift_amplitude": 50.0}),
