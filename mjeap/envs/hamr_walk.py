@@ -3,15 +3,16 @@ environment, and its open-loop trot as a scripted baseline (:func:`trot_policy`,
 :func:`run_trot`).
 
 * The model: the walker of :func:`mjeap.robots.hamr_walk.build` with LEARNING_SEGMENTS = 2
-  segments per actuator (the fewest an actuator takes) stepped at LEARNING_TIMESTEP = 50 us,
-  a step sized for the loaded system (the transmissions' 80-100 Hz modes, 200-250 steps a
-  period; the contact's 100 us time constant is 2 steps, MuJoCo's floor) instead of the free
-  beam's 4.51 us: the robot's trot runs within 5 % of the default model's speed at 10-65 Hz
-  (docs/robots/hamr-walk.md) at about real time on one core (scripts/bench.py
-  ``hamr_walk_env``). ``segments=4, timestep=None`` is the default model itself.
+  segments per actuator (the fewest an actuator takes) stepped at LEARNING_TIMESTEP = 100 us,
+  a step sized for the loaded system (the transmissions' 80-100 Hz modes, 100-125 steps a
+  period; the step's own damping h K is taken out of the legs' joints, and the contact's time
+  constant is 2 steps, MuJoCo's floor) instead of the free beam's 4.51 us: the robot's trot
+  runs within 5 % of the default model's speed at 10-65 Hz (docs/robots/hamr-walk.md) at
+  about real time on one core (scripts/bench.py ``hamr_walk_env``). ``segments=4,
+  timestep=None`` is the default model itself.
 * Action: the eight actuators' voltages (V, 0..200 at the walker's 200 V bias), in the
   order of :attr:`HamrWalkEnv.actuator_names` (FL_swing, FL_lift, FR_swing, ...), held for
-  ``control_interval`` s (default 0.5 ms, rounded to whole steps).
+  ``control_interval`` s (default 0.5 ms, rounded to whole steps: 5 at 100 us).
 * Observation (float64, SI, 27 values): the body's height above the ground (m), its
   orientation (quaternion, world), its velocity (m/s, world) and angular velocity (rad/s,
   body frame), the eight leg joints' angles (rad) and rates (rad/s), in the order of
@@ -49,7 +50,7 @@ SPEED_SCALE = 0.1           # m/s: the forward speed that earns a reward of 1 (t
 UPRIGHT_WEIGHT = 0.5
 ROLLOVER_DEG = 60.0         # deg: beyond this tilt the walker has rolled over
 LEARNING_SEGMENTS = 2       # segments per actuator of the environment's walker
-LEARNING_TIMESTEP = 5e-5    # s, its step, sized for the loaded system (see the module text)
+LEARNING_TIMESTEP = 1e-4    # s, its step, sized for the loaded system (see the module text)
 
 
 @functools.lru_cache(maxsize=1)
