@@ -87,19 +87,45 @@ def no_flight_lift(system: System, frequency: float, amplitude: float = AMPLITUD
     """The lift amplitude (V, at most ``amplitude``) at which a trot's stance pair cannot throw
     the body off the ground at ``frequency`` (Hz): the pair's legs carry the weight W on the
     lift actuators' stiffness (k_tip / T_lift^2 at each foot, the static sag W T^2 / (2 k_tip)
-    on two legs), and driving their feet down by A adds 2 k_tip A / T^2; for A beyond the sag
-    the pair's force swings from 2 W to below zero and the body flies. A = the sag is the lift
+    on two legs; W the weight the lift transmissions carry, :func:`sprung_weight`), and
+    driving their feet down by A adds 2 k_tip A / T^2; for A beyond the sag the pair's force
+    swings from 2 W to below zero and the body flies. A = the sag is the lift
     drive whose blocked force at the feet, 2 F_b' V / T_lift (F_b' the actuator's blocked force
     per volt: the laminate's free deflection / tip compliance), equals W, amplified by the lift
     transmission's second-order gain |H(f)| (80 Hz, hamr_leg.ZETA): V = W T_lift / (2 F_b'
-    |H(f)|) (23.3 V at 10 Hz, 8.3 V at 65 Hz). N. Doshi's Vicon measurement of HAMR-VI set down
+    |H(f)|) (17.8 V at 10 Hz, 6.3 V at 65 Hz). N. Doshi's Vicon measurement of HAMR-VI set down
     from the air (HarvardAgileRoboticsLab/drake, GaitRecoveryTransition/SystemIDJbrn.m,
     2018-05-17) puts the robot's legs' sag at 0.5-0.7 mm on four legs (about 1.0-1.4 mm on a
-    diagonal pair), against this model's 0.77 mm on two."""
+    diagonal pair), against this model's 0.30 mm on four."""
     _, blocked_per_volt, gain, ratio = _transmission(system, "lift", frequency)
-    m = system.model
-    weight = float(m.body_subtreemass[m.body("body").id] * np.linalg.norm(m.opt.gravity)) * system.units.force
-    return float(min(amplitude, weight * ratio / (2.0 * blocked_per_volt * gain)))
+    return float(min(amplitude, sprung_weight(system) * ratio / (2.0 * blocked_per_volt * gain)))
+
+
+def sprung_weight(system: System) -> float:
+    """The weight (N) the four lift transmissions carry at the feet: the robot's, less what
+    the parts turning with each lift (its leg rod and lever, on the lift axis) hang on their
+    own axis: each such part's weight times 1 - its centre's lateral arm / the foot's (the rod's
+    centre halfway out, the lever's on the axis). 1.09 of the robot's 1.43 g."""
+    m, d = system.model, mujoco.MjData(system.model)
+    mujoco.mj_kinematics(m, d)
+    g = float(np.linalg.norm(m.opt.gravity))
+    carried = float(m.body_subtreemass[m.body("body").id]) * g
+    for leg in LEGS:
+        hip, foot = d.body(f"{leg}/leg").xpos, d.site(f"{leg}/foot").xpos
+        arm = abs(foot[1] - hip[1])
+        for b in range(m.nbody):
+            if m.body_rootid[b] == m.body_rootid[m.body("body").id] and _inside(m, b, m.body(f"{leg}/leg").id):
+                carried -= float(m.body_mass[b]) * g * (1.0 - abs(d.xipos[b][1] - hip[1]) / arm)
+    return carried * system.units.force
+
+
+def _inside(m, b: int, root: int) -> bool:
+    """Body ``b`` is ``root`` or below it in the kinematic tree."""
+    while b > 0:
+        if b == root:
+            return True
+        b = int(m.body_parentid[b])
+    return False
 
 
 def travel_amplitude(system: System, dof: str, frequency: float, travel: float = ACTUATOR_RANGE) -> float:
