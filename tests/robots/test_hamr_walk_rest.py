@@ -80,7 +80,7 @@ def test_the_contact_is_sized_inside_its_window():
     constant at least 2 steps (MuJoCo's floor) and 5 tau within a tenth of the 65 Hz trot's
     half cycle; landings up to 1.3 m/s within the contact tolerance."""
     c = hw.contact_sizing(hw.build())
-    m, v, R = 0.094e-6, 0.4, hw.FOOT_RADIUS
+    m, v, R = 0.094e-3, 0.4, hw.FOOT_RADIUS          # kg, m/s, m
     hertz = [(15 * m * v * v / (16 * E * np.sqrt(R))) ** 0.4 for E in (1e9, 0.5e9)]
     assert hertz[0] <= v * c["landing_penetration_m_per_m_s"] <= hertz[1]
     assert c["timeconst_steps"] >= 2.0 - 1e-9
