@@ -64,12 +64,15 @@ def test_upside_down_the_robot_lies_on_its_chassis():
 
 @pytest.mark.slow
 def test_a_trot_that_rolls_over_lands_on_the_chassis_not_through_the_floor():
-    """The full drive at 100 Hz throws the robot over (measured: roll 180 deg); its chassis
-    reaches the ground (lowest corner within the tolerance of it) and never sinks more than
-    the contact tolerance into it, where it fell 17.5 mm through before the chassis collided."""
+    """The full drive at 100 Hz throws the robot over (measured: roll 147 deg with the 100 us
+    contact, 180 with the 45 us one); its chassis never sinks more than the contact tolerance
+    into the ground, where it fell 17.5 mm through before the chassis collided (it lands on
+    its side now, the chassis 5 mm up and a leg on the ground: lying on the chassis is the
+    upside-down test's)."""
     m = hw.walk_metrics(hw.walk(hw.build(), 100.0))
     assert max(m["max_abs_roll_deg"], m["max_abs_pitch_deg"]) > 90.0
-    assert -TOL < m["min_chassis_clearance_m"] < TOL
+    assert m["min_chassis_clearance_m"] > -TOL
+    assert min(m["min_chassis_clearance_m"], m["min_leg_clearance_m"]) < 1e-3
 
 
 def test_the_contact_is_sized_inside_its_window():
