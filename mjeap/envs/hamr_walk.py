@@ -67,7 +67,7 @@ class HamrWalkEnv(SystemEnv):
     LEARNING_TIMESTEP; None: the actuators' own, the default model's); ``render_mode`` one of
     those that work here (:mod:`mjeap.envs.rendering`), ``width`` and ``height`` in pixels."""
 
-    def __init__(self, control_interval: float = 5e-4, time_limit: float = 1.0, speed_scale: float = SPEED_SCALE,
+    def __init__(self, control_interval: float = 5e-4, time_limit: float = 1.0, *, speed_scale: float = SPEED_SCALE,
                  upright_weight: float = UPRIGHT_WEIGHT, rollover_deg: float = ROLLOVER_DEG, mu: float = MU,
                  segments: int = LEARNING_SEGMENTS, timestep: Optional[float] = LEARNING_TIMESTEP,
                  render_mode: Optional[str] = None, width: int = 480, height: int = 480):

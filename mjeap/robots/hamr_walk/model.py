@@ -210,7 +210,14 @@ def build(mu: float = MU, segments: int = SEGMENTS, *, bias: float = BIAS, incli
     if own <= 0:
         raise ParameterError("TOTAL_MASS", TOTAL_MASS, f"more than the actuators and legs ({others * 1e-6:.4g} kg)")
     box.mass = own
-    acts_list = list(acts.values())
+    return _system(spec, list(acts.values()), d, mu, timeconst_steps, timestep)
+
+
+def _system(spec: mujoco.MjSpec, acts_list: list, d: dict, mu: float, timeconst_steps: Optional[float],
+            timestep: Optional[float]) -> System:
+    """The walker's System from its spec (:func:`build`): the ground contact, the travel stops
+    and the solver's tolerance, at the actuators' own step or at ``timestep`` sized for the
+    loaded system (the legs' joint damping less the step's own)."""
     u = acts_list[0].twin.units
     h0 = min(a.twin.timestep for a in acts_list)         # the actuators' own step: the contact is sized on it
     h = h0 if timestep is None else check_range("timestep", timestep, 0.0, MAX_TIMESTEP, "s", lo_open=True)
