@@ -130,6 +130,24 @@ def phase_loop_gains(damping_ratio: float, resonance: float, frequency: float):
     return float(res.x[0]), float(res.x[1]), 0.0
 
 
+class PhaseControllers:
+    """Several :class:`LegPhaseController` as one system controller (``ctrls``: actuator
+    prefix -> controller, ``obs``: prefix -> its drive observer, ``dt``: the system's step,
+    set by a subclass): each reads only its actuator's drive current (the observer stepped
+    with the voltage it holds) and its own commands, nothing else of the system."""
+
+    ctrls: dict
+    obs: dict
+    dt: float
+
+    def __call__(self, t: float, system) -> dict:
+        out = {}
+        for nm, c in self.ctrls.items():
+            out[nm] = c(t, None)               # reads the current after the last step, nothing of the system
+            self.obs[nm].step(out[nm], self.dt)
+        return out
+
+
 class LegPhaseController:
     """Drives V = V_bias/2 + ``amplitude`` sin(2 pi ``frequency`` t + phi) (V) and, after
     ``open_loop_cycles`` cycles, moves phi once per cycle by a PID on the self-sensed phase

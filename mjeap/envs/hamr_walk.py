@@ -2,9 +2,17 @@
 environment, and its open-loop trot as a scripted baseline (:func:`trot_policy`,
 :func:`run_trot`).
 
+* The model: the walker of :func:`mjeap.robots.hamr_walk.build` with LEARNING_SEGMENTS = 2
+  segments per actuator (the fewest an actuator takes) stepped at LEARNING_TIMESTEP = 100 us,
+  a step sized for the loaded system (the transmissions' 80-100 Hz modes, 100-125 steps a
+  period; the step's own damping h K is taken out of the legs' joints, and the contact's time
+  constant is 2 steps, MuJoCo's floor) instead of the free beam's 4.51 us: the robot's trot
+  runs within 5 % of the default model's speed at 10-65 Hz (docs/robots/hamr-walk.md) at
+  about real time on one core (scripts/bench.py ``hamr_walk_env``). ``segments=4,
+  timestep=None`` is the default model itself.
 * Action: the eight actuators' voltages (V, 0..200 at the walker's 200 V bias), in the
   order of :attr:`HamrWalkEnv.actuator_names` (FL_swing, FL_lift, FR_swing, ...), held for
-  ``control_interval`` s (default 0.5 ms, rounded to whole 4.51 us steps).
+  ``control_interval`` s (default 0.5 ms, rounded to whole steps: 5 at 100 us).
 * Observation (float64, SI, 27 values): the body's height above the ground (m), its
   orientation (quaternion, world), its velocity (m/s, world) and angular velocity (rad/s,
   body frame), the eight leg joints' angles (rad) and rates (rad/s), in the order of
@@ -17,7 +25,8 @@ environment, and its open-loop trot as a scripted baseline (:func:`trot_policy`,
 
 The walker's own trot (:func:`mjeap.robots.hamr_walk.walk`) drives every MuJoCo step from
 its waveforms; through the environment the same waveforms are held over each control step,
-sampled at its middle (:func:`trot_policy`).
+sampled at its middle (:func:`trot_policy`; by default the robot's trot drive,
+:func:`mjeap.robots.hamr_walk.trot_drive`).
 """
 from __future__ import annotations
 
@@ -29,7 +38,7 @@ import numpy as np
 
 from ..errors import check_range
 from ..robots.hamr_leg.model import design
-from ..robots.hamr_walk.experiments import AMPLITUDE, trot_durations, trot_voltages
+from ..robots.hamr_walk.experiments import trot_drive, trot_durations, trot_voltages
 from ..robots.hamr_walk.model import LEGS, MU, body_position, body_rotation, build, ground_rotation
 from .rendering import check_render_mode
 from .system_env import SystemEnv
@@ -40,6 +49,8 @@ ENV_ID = "mjeap/HamrWalk-v0"
 SPEED_SCALE = 0.1           # m/s: the forward speed that earns a reward of 1 (the 10 Hz trot's 0.093 m/s)
 UPRIGHT_WEIGHT = 0.5
 ROLLOVER_DEG = 60.0         # deg: beyond this tilt the walker has rolled over
+LEARNING_SEGMENTS = 2       # segments per actuator of the environment's walker
+LEARNING_TIMESTEP = 1e-4    # s, its step, sized for the loaded system (see the module text)
 
 
 @functools.lru_cache(maxsize=1)
@@ -52,17 +63,19 @@ class HamrWalkEnv(SystemEnv):
     """HAMR-VI on a ground plane, walking under eight voltages (see the module text):
     ``control_interval`` and ``time_limit`` (s), the reward's ``speed_scale`` (m/s) and
     ``upright_weight``, the roll-over's ``rollover_deg``; the walker's ``mu`` (the feet's
-    friction, 0.51) and ``segments`` per actuator (4); ``render_mode`` one of those that
-    work here (:mod:`mjeap.envs.rendering`), ``width`` and ``height`` in pixels."""
+    friction, 0.51), ``segments`` per actuator (LEARNING_SEGMENTS) and ``timestep`` (s,
+    LEARNING_TIMESTEP; None: the actuators' own, the default model's); ``render_mode`` one of
+    those that work here (:mod:`mjeap.envs.rendering`), ``width`` and ``height`` in pixels."""
 
-    def __init__(self, control_interval: float = 5e-4, time_limit: float = 1.0, speed_scale: float = SPEED_SCALE,
+    def __init__(self, control_interval: float = 5e-4, time_limit: float = 1.0, *, speed_scale: float = SPEED_SCALE,
                  upright_weight: float = UPRIGHT_WEIGHT, rollover_deg: float = ROLLOVER_DEG, mu: float = MU,
-                 segments: int = 4, render_mode: Optional[str] = None, width: int = 480, height: int = 480):
+                 segments: int = LEARNING_SEGMENTS, timestep: Optional[float] = LEARNING_TIMESTEP,
+                 render_mode: Optional[str] = None, width: int = 480, height: int = 480):
         check_render_mode(render_mode)          # before the robot is built
         self.speed_scale = check_range("speed_scale", speed_scale, 1e-6, 10.0, "m/s")
         self.upright_weight = check_range("upright_weight", upright_weight, 0.0, 100.0)
         self.rollover_deg = check_range("rollover_deg", rollover_deg, 0.0, 180.0, "deg", lo_open=True)
-        system = build(mu=mu, segments=segments, d={k: dict(v) for k, v in leg_design().items()})
+        system = build(mu, segments, d={k: dict(v) for k, v in leg_design().items()}, timestep=timestep)
         m = system.model
         self._G = ground_rotation(system)
         self._joints = [f"{leg}/{dof}" for leg in LEGS for dof in ("swing", "lift")]
@@ -118,12 +131,18 @@ class HamrWalkEnv(SystemEnv):
         return f"rolled over: tilt {tilt:.1f} deg > {self.rollover_deg:g} deg" if tilt > self.rollover_deg else ""
 
 
-def trot_policy(env: HamrWalkEnv, frequency: float, amplitude: float = AMPLITUDE,
+def trot_policy(env: HamrWalkEnv, frequency: float, amplitude: Optional[float] = None,
                 lift_amplitude: Optional[float] = None):
     """The walker's open-loop trot (:func:`mjeap.robots.hamr_walk.trot_voltages`: diagonal
     pairs in phase, lifts 90 deg ahead, amplitude ramped over 2 cycles) as a policy:
     ``policy(t)`` returns the action for the control step starting at ``t`` s, the
-    waveforms sampled at the step's middle."""
+    waveforms sampled at the step's middle. ``amplitude`` and ``lift_amplitude`` (V) None:
+    the robot's trot drive (:func:`mjeap.robots.hamr_walk.trot_drive`); an ``amplitude``
+    alone drives the lifts with it too."""
+    if amplitude is None:
+        drive = trot_drive(env.unwrapped.system, frequency)
+        amplitude = drive["amplitude"]
+        lift_amplitude = drive["lift_amplitude"] if lift_amplitude is None else lift_amplitude
     waves = trot_voltages(frequency, amplitude, lift_amplitude=lift_amplitude)
     order = [waves[name] for name in env.unwrapped.actuator_names]
     half = 0.5 * env.unwrapped.control_timestep
@@ -133,7 +152,7 @@ def trot_policy(env: HamrWalkEnv, frequency: float, amplitude: float = AMPLITUDE
     return policy
 
 
-def run_trot(env: HamrWalkEnv, frequency: float, amplitude: float = AMPLITUDE,
+def run_trot(env: HamrWalkEnv, frequency: float, amplitude: Optional[float] = None,
              lift_amplitude: Optional[float] = None, settle: Optional[float] = None,
              measure: Optional[float] = None, seed: Optional[int] = 0) -> dict:
     """The scripted baseline: :func:`trot_policy` through ``env`` for the walker's settle

@@ -56,6 +56,9 @@ class SystemEnv(gymnasium.Env):
         self.control_timestep = self._n_sub * system.timestep
         self._step_limit = int(round(self.time_limit / self.control_timestep))
         self.metadata = {**type(self).metadata, "render_fps": 1.0 / self.control_timestep}
+        #: the driven actuators' ctrl indices: an action, checked finite and clipped to the drives'
+        #: safe ranges here, is written to them directly (System.set_voltages would check it again)
+        self._ctrl = np.array([system.actuator_ids[system.index(a.prefix)] for a in self.driven], dtype=int)
         ranges = np.array([a.drive.voltage_range() for a in self.driven], dtype=float)
         self._v_lo, self._v_hi = ranges[:, 0], ranges[:, 1]
         lo, hi = float32_inside(self._v_lo, self._v_hi)
@@ -125,7 +128,7 @@ class SystemEnv(gymnasium.Env):
         v = np.clip(a, self._v_lo, self._v_hi)
         self._saturated += int(np.any(v != a))
         self.voltages = v
-        self.system.set_voltages({act.prefix: float(x) for act, x in zip(self.driven, v)})
+        self.system.data.ctrl[self._ctrl] = v
         self._before_step()
         self._steps += 1
         info = self._info()

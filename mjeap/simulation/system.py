@@ -51,11 +51,18 @@ class System:
     is (beta - h) k of the system's h. The host's flags and gravity must still be those the
     actuators were attached under. The integrator is the actuators' (they were attached for one:
     'discrete' with contact, see :func:`attach`); ``integrator`` is needed only without
-    actuators. ``contact``: :class:`ContactParameters` (None: the host's own)."""
+    actuators. ``contact``: :class:`ContactParameters` (None: the host's own). ``loaded``: the
+    actuators drive heavy host parts (a transmission and a leg on each tip), so their loaded
+    modes, not the free beam's, set the dynamics: a given ``timestep`` is then checked only
+    against each actuator's stability limit (none under 'discrete', which takes the beam's
+    springs implicitly), not against the free beam's accuracy (T_1 / 50) and damping (beta /
+    2) limits, and the caller sizes it for the loaded system and checks it (e.g. against a
+    run at half the step: :meth:`half_step`). Above beta the step's own damping h K
+    exceeds the beam's Rayleigh damping (the joints then carry none)."""
 
     def __init__(self, spec: mujoco.MjSpec, actuators: Sequence[AttachedActuator], units: Optional[UnitSystem] = None,
                  timestep: Optional[float] = None, integrator: Optional[str] = None,
-                 contact: Optional[ContactParameters] = ContactParameters()):
+                 contact: Optional[ContactParameters] = ContactParameters(), *, loaded: bool = False):
         check_spec(spec)
         self.units = units = units or DEFAULT_UNITS
         self.actuators = list(actuators)
@@ -86,6 +93,7 @@ class System:
                         f"the gravity actuator '{a.prefix.rstrip('/')}' was attached under, {g_twin} m/s^2",
                         "its damping and timestep were chosen for that gravity: set the host's gravity and its flag "
                         "before attach")
+        self.loaded = bool(loaded)
         if timestep is None:
             if not self.actuators:
                 raise ParameterError("timestep", None, "a timestep in s for a system without actuators")
@@ -94,8 +102,12 @@ class System:
         else:
             h = check_positive("timestep", timestep, "s")
             for a in self.actuators:          # stability; accuracy and the joints' damping under discrete
-                a.twin.check_timestep(timestep)
-            self.timestep_reason = "given by the user"
+                if not loaded:
+                    a.twin.check_timestep(timestep)
+                elif timestep > a.twin.choice.stability_limit:
+                    raise ParameterError("timestep", timestep, f"a timestep <= {a.twin.choice.stability_limit:.4g} s",
+                                         f"the stability limit of actuator '{a.prefix.rstrip('/')}'")
+            self.timestep_reason = "given by the user" + (" for the loaded system (stability checked)" if loaded else "")
         self.spec = spec
         for a in self.actuators:
             if a.twin.builder.implicit_stiffness(a.twin.integrator):
@@ -367,7 +379,7 @@ class System:
         for p in self.parts:
             p.check_derivable()
         half = System(self.spec.copy(), self.actuators, self.units, timestep=self.timestep / 2,
-                      integrator=self.integrator, contact=self.contact)
+                      integrator=self.integrator, contact=self.contact, loaded=self.loaded)
         for p, q in zip(self.parts, half.parts):
             p.carry_loads(q)
         return half

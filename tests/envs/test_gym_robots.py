@@ -151,27 +151,32 @@ def test_refusals_name_the_parameter():
 
 
 @pytest.mark.slow
-def test_trot_through_the_env_reaches_the_walkers_speed():
-    """The scripted baseline: the walker's open-loop trot at 10 Hz, full amplitude (its
-    documented 0.093 m/s, upright), through the environment (the waveforms held over 0.5 ms
-    control steps) against the walker's own run (every 4.51 us step) with the same settle and
-    measuring windows: within 10 % (measured +0.9 %)."""
-    from mjeap.robots.hamr_walk import build, walk, walk_metrics
-    env = gymnasium.make("mjeap/HamrWalk-v0")
-    got = run_trot(env, 10.0)
-    ref = walk_metrics(walk(build(d=leg_design()), 10.0))
-    assert ref["upright"] and not got["ended"]
-    assert got["speed_m_s"] == pytest.approx(ref["speed_m_s"], rel=0.10)
+@pytest.mark.parametrize("frequency", [10.0, 20.0, 40.0, 65.0])
+def test_the_learning_model_trots_at_the_default_models_speed(frequency):
+    """HamrWalk-v0's model (2 segments per actuator at a 100 us step sized for the loaded
+    system, about real time on one core) against the default walker model (4 segments, the
+    actuators' own 4.51 us step), the robot's trot drive (trot_drive) through the environment
+    (its waveforms held over 0.5 ms control steps) and in the walker's own run, the same
+    windows (0.3 s settling, 0.4 s measured: at 40 Hz the issue's 0.2 s after 0.1 s still
+    carries the start, -6 %): within 5 % (measured -0.1, +0.1, -2.3, ... %), both upright."""
+    from mjeap.robots.hamr_walk import build, trot_drive, walk, walk_metrics
+    env = gymnasium.make("mjeap/HamrWalk-v0", time_limit=1.0)
+    got = run_trot(env, frequency, settle=0.3, measure=0.4)
+    s = build(d=leg_design())
+    ref = walk_metrics(walk(s, frequency, settle=0.3, measure=0.4, **trot_drive(s, frequency)))
+    assert ref["upright"] and not got["ended"] and got["max_tilt_deg"] < 30.0
+    assert got["speed_m_s"] == pytest.approx(ref["speed_m_s"], rel=0.05)
 
 
 def test_trot_through_the_env_quick():
-    """The same comparison, short (about 4 s here, kept in the quick loop as the baseline's
-    check): QUICK's trot (the ramp, then one cycle measured) through the environment and the
-    walker: within 10 %."""
+    """The environment's stepping on the default model (4 segments, the actuators' own step),
+    short (about 4 s here, kept in the quick loop as the baseline's check): QUICK's trot (the
+    ramp, then one cycle measured) through the environment (the waveforms held over 0.5 ms
+    control steps) and the walker's own run (every step): within 10 %."""
     from mjeap.robots.hamr_walk import build, walk, walk_metrics
     f, lift, settle, measure = QUICK
-    env = HamrWalkEnv(time_limit=settle + measure + 0.01)
-    got = run_trot(env, f, lift_amplitude=lift, settle=settle, measure=measure)
+    env = HamrWalkEnv(time_limit=settle + measure + 0.01, segments=4, timestep=None)
+    got = run_trot(env, f, amplitude=100.0, lift_amplitude=lift, settle=settle, measure=measure)
     ref = walk_metrics(walk(build(d=leg_design()), f, settle=settle, measure=measure, lift_amplitude=lift))
     assert not got["ended"] and ref["speed_m_s"] > 0.01
     assert got["speed_m_s"] == pytest.approx(ref["speed_m_s"], rel=0.10)

@@ -56,7 +56,7 @@ def test_at_80_hz_the_gait_not_the_contact_makes_the_body_hop(d):
     (FOOT_DROP + FOOT_RADIUS = 11.85 mm; at rest, loaded, 11.56 mm, hamr_walk.stand; its
     lowest here 15.3 mm). Only the time per landing follows the contact (duty factor 0.0047
     against 0.016, measured)."""
-    rows = st.contact_study(80.0, 20.0, steps=(hw.CONTACT_STEPS, 5 * hw.CONTACT_STEPS))
+    rows = st.contact_study(80.0, 20.0, steps=(hw.CONTACT_STEPS, 4 * hw.CONTACT_STEPS))
     standing = hw.FOOT_DROP + hw.FOOT_RADIUS        # m, the hips' height on unloaded legs
     for r in rows:
         assert r["touchdowns_per_cycle"] < 0.5, r

@@ -26,8 +26,8 @@ import json
 import numpy as np
 
 from ...analysis.frequency import phasor
-from ...controllers.hamr_leg import (LegPhaseController, cycles_to_within, free_estimator, phase_errors_per_cycle,
-                                     phase_loop_gains)
+from ...controllers.hamr_leg import (LegPhaseController, PhaseControllers, cycles_to_within, free_estimator,
+                                     phase_errors_per_cycle, phase_loop_gains)
 from ...errors import check_integer
 from ...io.commandline import arg_integer, arg_output, parse_args
 from ...io.outputs import run_guard
@@ -94,9 +94,9 @@ def phase_crossing(sw: dict) -> float:
     return float(f[i] + (-90 - ph[i]) * (f[i + 1] - f[i]) / (ph[i + 1] - ph[i]))
 
 
-class LegControllers:
-    """Both phase controllers as one system controller: each reads only its actuator's drive
-    current (a drive observer stepped with the voltage it holds) and its own commands."""
+class LegControllers(PhaseControllers):
+    """Both phase controllers as one system controller (controllers.hamr_leg.PhaseControllers:
+    each reads only its actuator's drive current and its own commands)."""
 
     name = "swing and lift phase PIDs on the self-sensed currents"
 
@@ -109,13 +109,6 @@ class LegControllers:
             self.obs[nm] = system.drive_observer(nm)
             c.reset(system, self.obs[nm])
             self.ctrls[nm] = c
-
-    def __call__(self, t: float, system: System) -> dict:
-        out = {}
-        for nm, c in self.ctrls.items():
-            out[nm] = c(t, None)               # reads the current after the last step, nothing of the system
-            self.obs[nm].step(out[nm], self.dt)
-        return out
 
 
 def run_closed_loop(system: System, cycles: int = 40, open_loop_cycles: int = 10, rrd=None) -> dict:

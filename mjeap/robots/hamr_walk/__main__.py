@@ -2,6 +2,6 @@
 import sys
 
 from ...io.commandline import run_script
-from .experiments import main
+from .cli import main
 
 sys.exit(run_script(main))

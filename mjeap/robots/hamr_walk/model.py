@@ -34,11 +34,11 @@ Model (host in mm, mg, ms; gravity along -z; x forward, y left, z up):
   that rolls over lands on its chassis or legs. Coulomb friction MU = 0.51 (the value of
   Doshi's HAMR trot simulations; a parameter), elliptic cone, impratio 10. MuJoCo's soft
   contact sized from the robot's physics in :func:`contact_parameters`: time constant
-  CONTACT_STEPS = 10 steps = 45 us (at least 10 steps; 5 tau within 5 % of the shortest
-  stance, 5 ms at 100 Hz; a landing at v penetrates v tau / e, 17 um per m/s), critically
-  damped, solimp (0.99, 0.999, 50 um): at rest each foot sinks 0.56 nm and creeps 0.12 um/s
-  under the legs' splay. The solimp width, 0.1 x FOOT_RADIUS = 50 um, is the contact
-  tolerance of the penetration checks.
+  CONTACT_TIMECONST = 100 us (a landing penetrates as a Hertz contact of the 0.5 mm foot on a
+  polymer or paper ground at the trot's landing speeds; v tau / e, 37 um per m/s), critically
+  damped, solimp (0.99, 0.999, 50 um): at rest each foot sinks nanometres and creeps under
+  the legs' splay (tested below 1 um/s). The solimp width, 0.1 x FOOT_RADIUS = 50 um, is the
+  contact tolerance of the penetration checks.
 - Travel: each actuator's tip deflection is held within +-ACTUATOR_RANGE = 0.3 mm (the range
   of the actuator joints in N. Doshi's HAMR-VI model, HAMR_scaledV2.urdf), a stop as stiff as
   the ground contact: the feet reach T x 0.3 mm = 3.9 mm (swing) and 3.6 mm (lift). The full
@@ -67,6 +67,8 @@ from ...simulation.system import ContactParameters, System, attach
 from ..hamr_leg.model import ACTUATOR, LEG_LENGTH, add_leg, design
 
 TOTAL_MASS = 1.43e-3            # kg, Jayaram et al. 2018
+PAPER_SPEED, PAPER_FREQUENCY = 0.5, 65.0      # m/s at Hz, Jayaram et al. 2018 ("approximately 0.5 m/s ... 65 Hz")
+PAPER_INCLINE = 22.0                          # deg, Jayaram et al. 2018 ("inclines nearing 22 deg")
 BODY_LENGTH = 45.1e-3           # m, Jayaram et al. 2018
 BODY_WIDTH = 15e-3              # m, assumed
 BODY_HEIGHT = 4e-3              # m, assumed
@@ -76,8 +78,12 @@ FOOT_RADIUS = 0.5e-3            # m, assumed
 MU = 0.51                       # sliding friction, as Doshi's HAMR trot simulations (see the module text)
 CONTACT_WIDTH_FRACTION = 0.1    # solimp width as a fraction of FOOT_RADIUS: the penetration tolerance
 IMPRATIO = 10.0                 # the friction rows' regulariser / 10: a sticking foot creeps 10 x less
-#: the contact's time constant in timesteps (contact_parameters: 10 h = 45 us at 4 segments)
-CONTACT_STEPS = 10.0
+#: s, the feet's contact time constant: a landing of the foot (about 0.1 g effective) penetrates
+#: as a Hertz contact of its 0.5 mm sphere on a polymer or paper ground (E* 0.5-1 GPa) at the
+#: trot's landing speeds, 0.2-1 m/s (contact_parameters)
+CONTACT_TIMECONST = 100e-6
+#: the same in the actuators' own steps (4.51 us at 4 segments)
+CONTACT_STEPS = 22.0
 #: the actuators' integrator: the feet's contact forces reach the beams through the
 #: transmissions, and 'implicitfast' sizes them for M alone (the feet chatter at rest)
 INTEGRATOR = "discrete"
@@ -98,10 +104,11 @@ CONTACT_SENSOR = [2, 3, 1]
 LEGS = {"FL": (1, 1, 0.0), "FR": (1, -1, np.pi), "RL": (-1, 1, np.pi), "RR": (-1, -1, 0.0)}
 
 
-def build(mu: float = MU, segments: int = SEGMENTS, bias: float = BIAS, incline_deg: float = 0.0,
+def build(mu: float = MU, segments: int = SEGMENTS, *, bias: float = BIAS, incline_deg: float = 0.0,
           d: Optional[dict] = None, armature_fraction: float = 0.0, foot_drop: float = FOOT_DROP,
-          body_width: float = BODY_WIDTH, timeconst_steps: float = CONTACT_STEPS,
-          upside_down: bool = False, integrator: str = INTEGRATOR, actuator_range: float = ACTUATOR_RANGE) -> System:
+          body_width: float = BODY_WIDTH, timeconst_steps: Optional[float] = None,
+          upside_down: bool = False, integrator: str = INTEGRATOR, actuator_range: float = ACTUATOR_RANGE,
+          timestep: Optional[float] = None) -> System:
     """The robot as a System (host in mm, mg, ms) standing on a ground plane tilted by
     ``incline_deg`` about y (uphill along +x); ``d``: hamr_leg.design() (computed if None).
 
@@ -113,19 +120,24 @@ def build(mu: float = MU, segments: int = SEGMENTS, bias: float = BIAS, incline_
     body's own mass takes up the rest: the robot still weighs TOTAL_MASS); ``foot_drop`` (m):
     the foot below the leg rod's end (its lateral motion per radian of lift); ``body_width``
     (m): the chassis width, the hips at its sides; ``timeconst_steps``: the contact's time
-    constant in timesteps (ContactParameters; CONTACT_STEPS, see :func:`contact_parameters`).
+    constant in the actuators' own steps (None: CONTACT_TIMECONST, see :func:`contact_parameters`).
     ``upside_down``: the body starts turned 180 degrees about x, its chassis 20 um above the
     ground (the rolled-over robot). ``integrator``: the actuators' ('discrete', INTEGRATOR:
     the feet's contacts reach the beams through the transmissions, see the module text).
     ``actuator_range`` (m): each actuator's tip travel either way (ACTUATOR_RANGE, a stop as
-    stiff as the ground contact)."""
+    stiff as the ground contact). ``timestep`` (s): None, the actuators' own step (beta / 2 of
+    the free beam, 4.51 us at 4 segments); a larger one is sized for the loaded system
+    (:func:`loaded_timestep`, System's ``loaded``): the contact keeps its time constant in
+    seconds (at least 2 steps, MuJoCo's floor) and the legs' joint damping gives back what the
+    step's own damping h K adds to the transmissions' modes (:func:`leg_damping_at_step`)."""
     mu = check_range("mu", mu, 0.0, 10.0)
     segments = check_integer("segments", segments, 1, 40)
     incline = np.radians(check_range("incline_deg", incline_deg, -45.0, 45.0, "deg"))
     armature_fraction = check_range("armature_fraction", armature_fraction, 0.0, 1.0, hi_open=True)
     foot_drop = check_range("foot_drop", foot_drop, 0.0, 0.05, "m")
     body_width = check_range("body_width", body_width, 6e-3, 0.1, "m")
-    timeconst_steps = check_range("timeconst_steps", timeconst_steps, 2.0, 100.0)
+    if timeconst_steps is not None:
+        timeconst_steps = check_range("timeconst_steps", timeconst_steps, 2.0, 100.0)
     if integrator not in ("discrete", "implicitfast"):
         raise ParameterError("integrator", integrator, "'discrete' or 'implicitfast'")
     d = design() if d is None else d
@@ -198,47 +210,83 @@ def build(mu: float = MU, segments: int = SEGMENTS, bias: float = BIAS, incline_
     if own <= 0:
         raise ParameterError("TOTAL_MASS", TOTAL_MASS, f"more than the actuators and legs ({others * 1e-6:.4g} kg)")
     box.mass = own
-    acts_list = list(acts.values())
+    return _system(spec, list(acts.values()), d, mu, timeconst_steps, timestep)
+
+
+def _system(spec: mujoco.MjSpec, acts_list: list, d: dict, mu: float, timeconst_steps: Optional[float],
+            timestep: Optional[float]) -> System:
+    """The walker's System from its spec (:func:`build`): the ground contact, the travel stops
+    and the solver's tolerance, at the actuators' own step or at ``timestep`` sized for the
+    loaded system (the legs' joint damping less the step's own)."""
     u = acts_list[0].twin.units
-    h = min(a.twin.timestep for a in acts_list)
-    contact = contact_parameters(h, mu, timeconst_steps)
+    h0 = min(a.twin.timestep for a in acts_list)         # the actuators' own step: the contact is sized on it
+    h = h0 if timestep is None else check_range("timestep", timestep, 0.0, MAX_TIMESTEP, "s", lo_open=True)
+    tau = CONTACT_TIMECONST if timeconst_steps is None else timeconst_steps * h0
+    tau = max(tau, 2.0 * h)                                # s: the contact's time constant, MuJoCo's floor 2 h
+    contact = contact_parameters(h, mu, tau / h)
     # System applies contact parameters only for actuators with contact: here the feet's
     contact.apply(spec, h / u.time, FOOT_RADIUS / u.length, u.length)
     spec.option.tolerance = SOLVER_TOLERANCE
     for a in acts_list:             # the stops as stiff as the ground contact (its time constant)
-        spec.tendon(a.name("tip_deflection")).solref_limit = [timeconst_steps * h / u.time, 1.0]
-    return System(spec, acts_list, contact=contact)
+        spec.tendon(a.name("tip_deflection")).solref_limit = [tau / u.time, 1.0]
+    if timestep is None:
+        return System(spec, acts_list, contact=contact)
+    beta = acts_list[0].twin.choice.rayleigh_beta
+    for leg in LEGS:                # the step damps the transmissions by h K: the legs carry the rest of ZETA
+        for dof, c in leg_damping_at_step(d, h, beta).items():
+            spec.joint(f"{leg}/{dof}").damping = [c / (u.mass * u.length ** 2 / u.time), 0.0, 0.0]
+    return System(spec, acts_list, timestep=h, contact=contact, loaded=True)
 
 
-def contact_parameters(h: float, mu: float = MU, timeconst_steps: float = CONTACT_STEPS) -> ContactParameters:
-    """The feet's (and the chassis's) contact with the ground for a timestep ``h`` (s),
-    sized from the robot's physics: the window below (:func:`contact_sizing` gives its
-    numbers for a built robot; other ``timeconst_steps`` are for studies,
+#: s, the largest step :func:`build` takes: 1/50 of the period of the fastest transmission mode (100 Hz)
+MAX_TIMESTEP = 2e-4
+
+
+def leg_damping_at_step(d: dict, h: float, beta: float) -> dict:
+    """Per degree of freedom the leg joint's damping (N m s) that keeps each transmission mode
+    at hamr_leg.ZETA when the system steps at ``h`` (s): under 'discrete' the beam's hinges are
+    damped by max(beta, h) K (their Rayleigh beta, or the step's own h K where that is larger),
+    which damps the loaded mode at omega by max(beta, h) omega / 2; the joint carries the rest,
+    2 (ZETA - max(beta, h) omega / 2) omega I (hamr_leg.design: the same with beta)."""
+    from ..hamr_leg.model import DOFS, ZETA
+    out = {}
+    for dof, tr in DOFS.items():
+        w = 2 * np.pi * tr.resonance
+        share = 0.5 * max(beta, h) * w
+        if share >= ZETA:
+            raise ParameterError("timestep", h, f"a step whose own damping h omega / 2 stays below ZETA = {ZETA:g} "
+                                 f"at the {dof} resonance ({tr.resonance:g} Hz): h < {2 * ZETA / w:.3g} s")
+        out[dof] = 2 * (ZETA - share) * w * d[dof]["joint_inertia_kg_m2"]
+    return out
+
+
+def contact_parameters(h: float, mu: float = MU, timeconst_steps: Optional[float] = None) -> ContactParameters:
+    """The feet's (and the chassis's) contact with the ground for a timestep ``h`` (s), sized
+    from the robot's physics (:func:`contact_sizing` gives its numbers for a built robot;
+    ``timeconst_steps`` other than None, the time constant in steps of ``h``, are for studies,
     hamr_walk.study.contact_study).
 
-    solref = (tau, 1), tau = CONTACT_STEPS h = 45 us at the walker's h = 4.51 us (the
-    discrete integrator's beta / 2, beta = 2 zeta_1 / omega_1 of the actuator's first mode;
-    4.4-4.5 us for 2-20 segments). Critically damped: a landing foot does not rebound off
-    the contact itself (its penetration obeys r'' + 2 r' / tau + r / tau^2 = 0). The window:
-    - tau >= 10 h: MuJoCo integrates the contact's reference dynamics over the steps; at
-      its floor, 2 h, the normal and friction rows are deadbeat from one step to the next
-      (a projection, not a resolved response; under 'implicitfast' the 2-step contact left
-      the robot at rest with no foot down in 40 % of the steps, though the integrator was
-      the cause: under 'discrete' it rests, module text);
-    - 5 tau (the critically damped response within 4 %) <= 5 % of the shortest stance, half
-      a cycle at the command line's top frequency (100 Hz: 5 ms): tau <= 50 us;
-    - a foot landing at v penetrates at most v tau / e: 23 um at the 1.4 m/s landings of the
-      80 Hz, 20 V hops, within the solimp width (the contact tolerance, 50 um = 0.1 x the
-      foot radius; tau <= 97 us there).
+    solref = (tau, 1), tau = CONTACT_TIMECONST = 100 us, critically damped: a landing foot does
+    not rebound off the contact itself (its penetration obeys r'' + 2 r' / tau + r / tau^2 = 0)
+    and penetrates at most v tau / e, 37 um per m/s. Sized from the foot's real contact: a
+    sphere of FOOT_RADIUS with the foot's effective mass (about 0.1 g: a dropped robot's feet
+    stop 0.094 g each) landing at v on a surface of reduced modulus E* penetrates (Hertz)
+    (15 m v^2 / (16 E* sqrt(R)))^(2/5): on a polymer or paper ground (E* 0.5-1 GPa) at the
+    trot's landing speeds (0.2-1 m/s) 8-36 um, the depth of a critically damped contact of
+    tau = 75-135 us (E* 3 GPa: 48-66 us). The window it keeps: at least 2 steps (MuJoCo's
+    floor; 22 at the actuators' own 4.51 us, 2 at a 50 us step sized for the loaded system)
+    and 5 tau = 0.5 ms, 7 % of the 65 Hz trot's half cycle; a landing within the solimp width
+    (the contact tolerance, 50 um = 0.1 x the foot radius) up to 1.4 m/s.
     solimp (dmin 0.99, dmax 0.999, width 50 um): at rest a foot carrying a quarter of the
     weight (3.5 mN) on its effective mass (156 mg, MuJoCo's diagonal of the contact's
-    inverse inertia) sinks (1 - d) / d^2 x tau^2 F / m = 0.46 nm (0.56 measured, MuJoCo's
-    discrete step); as a spring that is 6e6 N/m against the legs' 9 N/m (k_foot: the body
-    bounces at 18-25 Hz on its legs, not on the contact). Friction: mu, elliptic cone,
+    inverse inertia) sinks (1 - d) / d^2 x tau^2 F / m = 2.3 nm. Friction: mu, elliptic cone,
     impratio IMPRATIO: a sticking foot under a tangential force f creeps at about
     (1 - d) / d x (f / m) x dmax tau / (2 impratio) (the legs splay under the weight, 0.21 of
-    it sideways on each foot: 0.12 um/s; impratio 1 would make it 10 x more)."""
-    steps = check_range("timeconst_steps", timeconst_steps, 2.0, 100.0)
+    it sideways on each foot; impratio 1 would make it 10 x more). MuJoCo's convex contact
+    starts a slip only with some motion along the normal: a sliding contact is pushed apart
+    (hamr_walk.study.sliding_contact)."""
+    steps = CONTACT_TIMECONST / h if timeconst_steps is None else timeconst_steps
+    steps = check_range("timeconst_steps", steps, 2.0, 100.0)
     return ContactParameters(friction=(mu, 5e-6, 1e-7), impratio=IMPRATIO, width_fraction=CONTACT_WIDTH_FRACTION,
                              timeconst_steps=steps)
 

@@ -69,6 +69,8 @@ import numpy as np
 
 from ...errors import ParameterError
 from . import experiments as hw
+from .metrics import UPRIGHT_DEG
+from .model import PAPER_FREQUENCY
 from . import model
 
 #: (label, build options, walk options): one parameter changed per row
@@ -80,21 +82,21 @@ VARIANTS = (
     ("mu 1.0", {"mu": 1.0}, {}),
     ("no shank (foot_drop 0)", {"foot_drop": 0.0}, {}),
     ("body 30 mm wide", {"body_width": 0.03}, {}),
-    ("contact 5x softer (timeconst_steps 50)", {"timeconst_steps": 50.0}, {}),
+    ("contact 2.2x softer (timeconst_steps 50)", {"timeconst_steps": 50.0}, {}),
     ("lift 20 V", {}, {"lift_amplitude": 20.0}),
     ("lift 30 V", {}, {"lift_amplitude": 30.0}),
     ("lift 50 V", {}, {"lift_amplitude": 50.0}),
 )
 
 
-def study_run(frequency: float = hw.PAPER_FREQUENCY, build: Optional[dict] = None, walk: Optional[dict] = None,
+def study_run(frequency: float = PAPER_FREQUENCY, build: Optional[dict] = None, walk: Optional[dict] = None,
               d: Optional[dict] = None, **walk_kw) -> dict:
     """One trot: hamr_walk.build(**build) walked at ``frequency`` (walk options ``walk``);
     its walk_metrics."""
     return hw.walk_metrics(hw.walk(model.build(d=d, **(build or {})), frequency, **(walk or {}), **walk_kw))
 
 
-def rolling_study(variants: Sequence = VARIANTS, frequency: float = hw.PAPER_FREQUENCY) -> list:
+def rolling_study(variants: Sequence = VARIANTS, frequency: float = PAPER_FREQUENCY) -> list:
     """Each of ``variants`` ((label, build options, walk options)) at ``frequency``: label,
     upright, speed (m/s), max |roll| and |pitch| (deg), the body's height range (m)."""
     if not len(variants):
@@ -213,9 +215,13 @@ def sliding_contact(speeds: Sequence[float] = SLIDE_SPEEDS, duration: float = 0.
     return rows
 
 
-#: Hz and V: the gait study's trots (full drive, half and 30 V)
+#: Hz, the gait study's trot frequencies
 GAIT_FREQUENCIES = (10.0, 20.0, 30.0, 40.0, 50.0, 65.0)
-GAIT_AMPLITUDES = (hw.AMPLITUDE, 50.0, 30.0)
+#: the gait study's drives: (label, swing amplitude V, robot): the robot's trot drive
+#: (hamr_walk.trot_drive: the swing within its travel, the no-flight lift) at the full and at
+#: half the amplitude, and the full drive (100 V on every actuator)
+GAIT_DRIVES = (("robot drive, full swing", hw.AMPLITUDE, True), ("robot drive, half swing", 0.5 * hw.AMPLITUDE, True),
+               ("full drive, 100 V on every actuator", hw.AMPLITUDE, False))
 #: mm per cycle and m/s the robot is published at (see docs/robots/hamr-walk.md, Gait study)
 PUBLISHED = (
     {"source": "Jayaram et al. 2018 (section 6.2)", "frequency_hz": 65.0, "speed_m_s": 0.5,
@@ -224,33 +230,43 @@ PUBLISHED = (
      "what": "fastest planned gait, 'a maximum of 10.87 mm/cycle, 15 % faster than previously measured'"},
     {"source": "Doshi et al. 2019, arXiv 1901.09065 (abstract)", "frequency_hz": None, "mm_per_cycle": 10.87 / 1.15,
      "what": "the previously measured best, 10.87 / 1.15 = 9.45 mm/cycle"},
+    {"source": "Goldberg, Doshi and Wood 2017, ICRA (abstract)", "frequency_hz": None, "speed_m_s": 0.294,
+     "what": "trajectory control with gaits at 2-45 Hz, 'speeds up to 6.5 BL/s (29.4 cm/s)'"},
 )
 
 
-def gait_study(frequencies: Sequence[float] = GAIT_FREQUENCIES, amplitudes: Sequence[float] = GAIT_AMPLITUDES,
+def gait_study(frequencies: Sequence[float] = GAIT_FREQUENCIES, drives: Sequence[tuple] = GAIT_DRIVES,
                settle: float = 0.3, measure: float = 0.2, on_row=None) -> list:
-    """The trot's speed per frequency and amplitude: per (frequency, amplitude) a
-    :func:`study_run` of the default model over ``measure`` s after ``settle`` s (the
-    issue's bands: after 0.3 s), with speed (m/s and mm per cycle), upright, the largest
-    roll and pitch over the whole run, the contact read-outs and the body's highest point
-    (its hops). ``on_row(row)`` is called after each run (to write as it goes)."""
-    if not len(frequencies) or not len(amplitudes):
-        raise ParameterError("frequencies, amplitudes", (frequencies, amplitudes), "at least one of each")
+    """The trot's speed per frequency and drive: per (frequency, drive of ``drives``: label,
+    amplitude V, robot) a walk of the default model over ``measure`` s after ``settle`` s (the
+    issue's bands: after 0.3 s), the robot's drive (hamr_walk.trot_drive at that amplitude)
+    or the amplitude on every actuator, with speed (m/s and mm per cycle), upright, the
+    largest roll and pitch over the whole run, the contact read-outs and the body's highest
+    point (its hops). ``on_row(row)`` is called after each run (to write as it goes)."""
+    if not len(frequencies) or not len(drives):
+        raise ParameterError("frequencies, drives", (frequencies, drives), "at least one of each")
     d = model.design()
     rows = []
-    for a in amplitudes:
+    for label, a, robot in drives:
         for f in frequencies:
-            run = hw.walk(model.build(d=d), float(f), float(a), settle=settle, measure=measure)
+            system = model.build(d=d)
+            drive = hw.trot_drive(system, float(f), float(a)) if robot else {"amplitude": float(a),
+                                                                             "lift_amplitude": float(a)}
+            run = hw.walk(system, float(f), settle=settle, measure=measure, **drive)
             m = hw.walk_metrics(run)
             rp = np.degrees(np.abs(np.array([model.roll_pitch(R, run["ground"]) for R in run["R"]])))
-            row = {"frequency_hz": float(f), "amplitude_v": float(a), "speed_m_s": m["speed_m_s"],
+            row = {"frequency_hz": float(f), "drive": label, "amplitude_v": drive["amplitude"],
+                   "lift_amplitude_v": drive["lift_amplitude"], "speed_m_s": m["speed_m_s"],
                    "mm_per_cycle": m["speed_m_s"] / f * 1e3,
-                   "upright_whole_run": bool(rp.max() < hw.UPRIGHT_DEG),
+                   "upright_whole_run": bool(rp.max() < UPRIGHT_DEG),
                    "max_abs_roll_deg_whole_run": float(rp[:, 0].max()),
                    "max_abs_pitch_deg_whole_run": float(rp[:, 1].max()),
-                   "body_height_max_m": m["body_height_range_m"][1], "wall_s": m["wall_time_s"],
-                   **{k: m[k] for k in ("kinematic_speed_m_s", "duty_factor", "contact_duty_factor",
-                                        "loaded_step_fraction", "contact_touchdowns_per_cycle",
+                   "body_height_min_m": m["body_height_range_m"][0], "body_height_max_m": m["body_height_range_m"][1],
+                   "wall_s": m["wall_time_s"],
+                   **{k: m[k] for k in ("kinematic_speed_m_s", "duty_factor", "touchdowns_per_cycle",
+                                        "time_with_a_foot_down", "contact_duty_factor_sampled",
+                                        "contact_when_near_sampled", "contact_touchdowns_per_cycle_sampled",
+                                        "contact_duty_factor", "loaded_step_fraction", "contact_touchdowns_per_cycle",
                                         "step_touchdowns_per_cycle", "contact_when_near", "force_balance_error",
                                         "slip_fraction")}}
             rows.append(row)
@@ -261,28 +277,27 @@ def gait_study(frequencies: Sequence[float] = GAIT_FREQUENCIES, amplitudes: Sequ
 
 def gait_figure(rows: Sequence[dict], path) -> None:
     """The gait study's figure (PNG at ``path``): mm per cycle and m/s against frequency per
-    drive amplitude (filled: upright over the whole run; open: tilted past UPRIGHT_DEG),
+    drive (filled: upright over the whole run; open: tilted past UPRIGHT_DEG),
     beside the published HAMR-VI numbers (PUBLISHED). Needs matplotlib (the report extra)."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from ...io.outputs import replacing
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.6))
-    amps = sorted({r["amplitude_v"] for r in rows}, reverse=True)
-    colours = dict(zip(amps, ("tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:brown")))
+    drives = list(dict.fromkeys(r["drive"] for r in rows))
+    colours = dict(zip(drives, ("tab:blue", "tab:orange", "tab:red", "tab:purple", "tab:brown")))
     for ax, key, unit in ((axes[0], "mm_per_cycle", "mm per cycle"), (axes[1], "speed_m_s", "m/s")):
-        for a in amps:
-            rs = sorted((r for r in rows if r["amplitude_v"] == a), key=lambda r: r["frequency_hz"])
+        for dr in drives:
+            rs = sorted((r for r in rows if r["drive"] == dr), key=lambda r: r["frequency_hz"])
             f = np.array([r["frequency_hz"] for r in rs])
             y = np.array([r[key] for r in rs])
             up = np.array([r["upright_whole_run"] for r in rs])
-            ax.plot(f, y, "-", color=colours[a], lw=1, alpha=0.6)
-            kind = "full drive" if a == hw.AMPLITUDE else "reduced"
+            ax.plot(f, y, "-", color=colours[dr], lw=1, alpha=0.6)
             if up.any():
-                ax.plot(f[up], y[up], "o", color=colours[a], label=f"mjeap, {a:g} V ({kind}): upright")
+                ax.plot(f[up], y[up], "o", color=colours[dr], label=f"mjeap, {dr}: upright")
             if (~up).any():
-                ax.plot(f[~up], y[~up], "o", mfc="none", color=colours[a],
-                        label=f"mjeap, {a:g} V ({kind}): tilted past {hw.UPRIGHT_DEG:g} deg")
+                ax.plot(f[~up], y[~up], "o", mfc="none", color=colours[dr],
+                        label=f"mjeap, {dr}: tilted past {UPRIGHT_DEG:g} deg")
         ax.axhline(0.0, color="0.6", lw=0.8)
         ax.set_xlabel("stride frequency (Hz)")
         ax.set_ylabel(f"forward speed ({unit})")
@@ -291,6 +306,9 @@ def gait_figure(rows: Sequence[dict], path) -> None:
             axes[1].plot(p["frequency_hz"], p["speed_m_s"], "*", ms=14, color="k", label=f"{p['source']}: 0.5 m/s")
             axes[0].plot(p["frequency_hz"], p["speed_m_s"] / p["frequency_hz"] * 1e3, "*", ms=14, color="k",
                          label=f"{p['source']}: {p['speed_m_s'] / p['frequency_hz'] * 1e3:.2f} mm/cycle")
+        elif "speed_m_s" in p:
+            axes[1].axhline(p["speed_m_s"], color="k", ls="-.", lw=1,
+                            label=f"{p['source']}: {p['speed_m_s']:g} m/s (gaits at 2-45 Hz)")
         elif "mm_per_cycle" in p:
             ax = axes[0]
             ax.axhline(p["mm_per_cycle"], color="k", ls="--" if p["mm_per_cycle"] > 10 else ":", lw=1,
@@ -298,6 +316,10 @@ def gait_figure(rows: Sequence[dict], path) -> None:
     axes[0].set_title("per cycle")
     axes[1].set_title("per second")
     handles, labels = axes[0].get_legend_handles_labels()
+    for h, lab in zip(*axes[1].get_legend_handles_labels()):
+        if lab not in labels and "mm/cycle" not in lab and ": 0.5 m/s" not in lab:
+            handles.append(h)
+            labels.append(lab)
     fig.legend(handles, labels, fontsize=7, loc="lower center", ncol=2, bbox_to_anchor=(0.5, -0.02))
     fig.suptitle("HAMR-VI open-loop trot: mjeap (hamr_walk, 0.3 s settling, 0.2 s measured) and the robot")
     fig.tight_layout(rect=(0, 0.2, 1, 0.95))
@@ -314,13 +336,11 @@ def gait_main(argv=None):
     import sys
     from ...io.commandline import arg_number, arg_output, parse_args
     from ...io.outputs import replacing, run_guard
-    ap = argparse.ArgumentParser(description="HAMR-VI's trot speed per frequency and amplitude beside the robot's")
+    ap = argparse.ArgumentParser(description="HAMR-VI's trot speed per frequency and drive beside the robot's")
     ap.add_argument("--out", default="out/hamr_walk_gait.json", type=arg_output(), help="results (.json)")
     ap.add_argument("--figure", default="out/hamr_walk_gait.png", type=arg_output(), help="figure (.png)")
     ap.add_argument("--frequencies", nargs="+", type=arg_number(*model.FREQUENCY_RANGE, "Hz"),
                     default=list(GAIT_FREQUENCIES), help="trot frequencies (Hz)")
-    ap.add_argument("--amplitudes", nargs="+", type=arg_number(0.0, hw.AMPLITUDE, "V"), default=list(GAIT_AMPLITUDES),
-                    help=f"drive amplitudes (V; {hw.AMPLITUDE:g}: full drive)")
     ap.add_argument("--settle", type=arg_number(0.0, 10.0, "s"), default=0.3, help="settling before the window (s)")
     ap.add_argument("--measure", type=arg_number(0.0, 10.0, "s", True), default=0.2, help="the window (s)")
     ap.add_argument("--from-json", type=str, default=None,
@@ -335,11 +355,12 @@ def gait_main(argv=None):
 
             def write(row):
                 rows.append(row)
-                print(f"{row['frequency_hz']:g} Hz, {row['amplitude_v']:g} V: {row['speed_m_s']:.3f} m/s "
+                print(f"{row['frequency_hz']:g} Hz, {row['drive']} (swing {row['amplitude_v']:.3g} V, lift "
+                      f"{row['lift_amplitude_v']:.3g} V): {row['speed_m_s']:.3f} m/s "
                       f"({row['mm_per_cycle']:.2f} mm/cycle), upright {row['upright_whole_run']}", file=sys.stderr)
                 with replacing(a.out, "--out") as tmp:
                     tmp.write_text(json.dumps({"runs": rows, "published": list(PUBLISHED)}, indent=1, default=float))
-            gait_study(a.frequencies, a.amplitudes, a.settle, a.measure, on_row=write)
+            gait_study(a.frequencies, GAIT_DRIVES, a.settle, a.measure, on_row=write)
         try:
             gait_figure(rows, a.figure)
         except ImportError:
