@@ -13,7 +13,8 @@ CSV, the optimisation's files and design-study.png; ``--png`` puts the figure el
     python examples/design_study.py                 # about 10 s on 2 cores (7 s measured)
 
 The figure needs matplotlib, mjeap's ``report`` extra (``pip install "mjeap[report]"``);
-without it the study runs and says so, and only the figure is left out.
+without it the study runs and says so, and only the figure is left out (``--png`` without it is
+refused before any work).
 """
 import argparse
 import importlib.util
@@ -42,6 +43,8 @@ def main(argv=None):
     a = ap.parse_args(argv)
     out = Path(a.out)
     figure = importlib.util.find_spec("matplotlib") is not None
+    if not figure and a.png:            # a file asked for by name is never silently left out
+        ap.error("--png: the figure needs matplotlib, which is not installed (pip install \"mjeap[report]\")")
     if not figure:                      # said before the work, not after it
         print("design_study: matplotlib is not installed: the figure is left out (pip install \"mjeap[report]\" "
               "for it); the sweep and the optimisation run", file=sys.stderr)

@@ -50,7 +50,8 @@ class Command:
     the output path (the user's) or the folder (``picked``: the name mjeap picks there).
     ``input``: which of its :class:`Inputs` an output may never be (its argv reads it).
     ``script``: run as ``python SCRIPT ARGV`` (else ``mjeap ARGV`` in this process).
-    ``slow``: a run that accepts the target does minutes of work (a device under a user's name)."""
+    ``slow``: a run that accepts the target does minutes of work (a device under a user's name).
+    ``needs``: an optional module the output cannot be written without (its test skips without it)."""
 
     argv: Callable[[str, Inputs], list]
     picked: Optional[str] = None
@@ -58,6 +59,7 @@ class Command:
     script: Optional[str] = None
     slow: bool = False
     cwd: bool = False              # the picked name is relative to the working directory (a default --out)
+    needs: Optional[str] = None
 
 
 QUICK_ROLLOUT = ["--voltage", "step:1V", "--duration", "0.002", "--segments", "4", "--quiet"]
@@ -108,7 +110,7 @@ COMMANDS = {
     "scripts/bench.py --json": Command(lambda o, f: ["--only", "models", "--min-seconds", "0.001", "--json", o],
                                        script="scripts/bench.py", slow=True),
     "examples/design_study.py --png": Command(lambda o, f: ["--png", o], script="examples/design_study.py",
-                                              slow=True),
+                                              slow=True, needs="matplotlib"),
 }
 
 
@@ -258,6 +260,8 @@ CASES = [pytest.param(c, t, marks=[pytest.mark.slow] if COMMANDS[c].slow or COMM
 @pytest.mark.parametrize("command,target", CASES)
 def test_every_writer_against_every_target(tmp_path, capsys, monkeypatch, command, target):
     cmd = COMMANDS[command]
+    if cmd.needs is not None:
+        pytest.importorskip(cmd.needs, reason=f"{command} writes nothing without {cmd.needs}")
     f = _inputs(tmp_path)
     monkeypatch.chdir(tmp_path)
     folder = tmp_path / "out-folder"

@@ -463,6 +463,19 @@ def test_the_design_study_without_matplotlib_names_the_report_extra(tmp_path):
     assert (tmp_path / "o" / "grid.csv").is_file() and not (tmp_path / "o" / "design-study.png").exists()
 
 
+def test_the_design_study_refuses_a_named_png_without_matplotlib_before_any_work(tmp_path):
+    """A file asked for by name is never silently left out: ``--png`` without matplotlib is an
+    error naming the option and the extra, and nothing runs."""
+    code = ("import sys, runpy\nsys.modules['matplotlib'] = None\nsys.argv = ['design_study.py', '--out', "
+            f"{str(tmp_path / 'o')!r}, '--png', {str(tmp_path / 'f.png')!r}]\n"
+            f"runpy.run_path({str(ROOT / 'examples' / 'design_study.py')!r}, run_name='__main__')\n")
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, env=ENV, timeout=120)
+    assert p.returncode == 2 and "Traceback" not in p.stderr, p.stderr[-2000:]
+    [line] = [l for l in p.stderr.splitlines() if ": error: " in l]
+    assert "--png" in line and "mjeap[report]" in line
+    assert not (tmp_path / "o").exists() and not (tmp_path / "f.png").exists()
+
+
 def test_the_readme_names_every_shipped_file_slower_than_real_time():
     """docs/bench.json (scripts/bench.py --only models) holds the real-time factor of every
     file mjeap.assets.path hands out; the README says which play slower than real time."""
