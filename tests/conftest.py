@@ -40,7 +40,8 @@ def pytest_collection_modifyitems(config, items):
     no_cable = pytest.mark.skip(reason=f"the cable representation needs MuJoCo 3.x (here {MUJOCO_VERSION})")
     rod_problem = BUILDERS["rod"].unavailable_reason()
     no_rod = pytest.mark.skip(reason=f"the rod representation: {rod_problem}")
-    no_dmc = pytest.mark.skip(reason=dm_control_problem() or "")
+    dmc_problem, has_cable = dm_control_problem(), cable_available()     # asked once, not per test
+    no_dmc = pytest.mark.skip(reason=dmc_problem or "")
     def values(x):
         if isinstance(x, dict):
             x = list(x.values())
@@ -53,9 +54,9 @@ def pytest_collection_modifyitems(config, items):
         if layer:
             item.add_marker(f"layer_{layer}")
         params = getattr(getattr(item, "callspec", None), "params", {})
-        if not cable_available() and ("cable" in item.keywords or any(isinstance(v, str) and v == "cable" for v in values(params))):
+        if not has_cable and ("cable" in item.keywords or any(isinstance(v, str) and v == "cable" for v in values(params))):
             item.add_marker(no_cable)
         if rod_problem and ("rod" in item.keywords or any(isinstance(v, str) and v == "rod" for v in values(params))):
             item.add_marker(no_rod)
-        if dm_control_problem() and "dm_control" in item.keywords:
+        if dmc_problem and "dm_control" in item.keywords:
             item.add_marker(no_dmc)

@@ -160,6 +160,7 @@ def test_a_drive_without_current_leaves_the_admittance_empty_and_says_why(tmp_pa
     assert "models no current" in json.loads((out / "frf.json").read_text())["admittance"]
 
 
+@pytest.mark.slow
 def test_mjeap_frf_writes_the_csv_the_json_and_the_bode_plot(tmp_path):
     """The command's files: frf.csv with the issue's columns, 2 kHz = 2000 Hz, the resonance
     in frf.json equal to the Python API's, frf.png (the report extra)."""

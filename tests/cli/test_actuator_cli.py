@@ -233,6 +233,7 @@ def test_identify_step_refusals_before_the_fit(tmp_path, capsys):
     assert sorted(x.name for x in tmp_path.iterdir()) == ["step.csv"]
 
 
+@pytest.mark.slow
 def test_identify_hinges_puts_the_quasi_static_EI_in_the_file(tmp_path, capsys):
     """A slow blocking force bends the trilayer into an arc of kappa = (2/3) F1 V L (1 -
     exp(-t/tau)) / EI; with EI 1.3 x the file's the identified file holds that EI (k L/N)."""

@@ -254,6 +254,7 @@ def _alive(pid: int) -> bool:
 
 
 @pytest.mark.skipif(not Path("/proc").is_dir(), reason="reads /proc")
+@pytest.mark.slow
 def test_render_recording_stops_the_viewer_the_wrapper_started(tmp_path):
     """`rerun` is a wrapper that starts the viewer as its child: stopping the wrapper alone
     left the viewer (~360 MB) running after the script exited. A fake wrapper here starts a

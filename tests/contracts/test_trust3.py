@@ -341,6 +341,7 @@ def test_a_signal_while_mujoco_runs_the_warning_callback_stops_the_run_cleanly(s
 
 
 # ---------------------------------------------------------------- 4. streams, base files, infeasible optima
+@pytest.mark.slow
 def test_csv_to_stdout_appends_behind_a_shell_redirect(tmp_path):
     log = tmp_path / "log.txt"
     log.write_text("kept line\n")
@@ -463,6 +464,7 @@ def test_the_design_study_without_matplotlib_names_the_report_extra(tmp_path):
     assert (tmp_path / "o" / "grid.csv").is_file() and not (tmp_path / "o" / "design-study.png").exists()
 
 
+@pytest.mark.slow
 def test_the_design_study_refuses_a_named_png_without_matplotlib_before_any_work(tmp_path):
     """A file asked for by name is never silently left out: ``--png`` without matplotlib is an
     error naming the option and the extra, and nothing runs."""

@@ -54,6 +54,7 @@ def test_unreachable_reference_saturates_with_a_warning(tmp_path):
     assert "/log" in read_recording(tmp_path / "sat.rrd")
 
 
+@pytest.mark.slow
 def test_unstable_gains_are_reported_with_the_controller_named():
     """A destabilising (negative) proportional gain with a huge magnitude diverges or rails;
     any divergence error names the controller."""

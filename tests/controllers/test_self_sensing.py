@@ -102,6 +102,7 @@ def test_without_the_blocking_factor_the_estimate_fails(scene, sweeps):
     assert np.abs(mag).max() > 5 * MAG_TOL
 
 
+@pytest.mark.slow
 def test_noise_on_the_current_grows_the_error_linearly(scene):
     """Gaussian noise of sigma on every current sample enters v_sen as alpha sigma (V is
     known exactly, so nothing is differentiated): the least-squares phasor over N samples

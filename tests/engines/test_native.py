@@ -22,7 +22,7 @@ from mjeap.validation import golden
 
 CASES = [  # actuator, scene kwargs, waveform, duration s, initial curvature 1/m, tolerance (of the swing)
     ("pedot-micro", {"orientation": "up", "payload": "12.6mg@6.27mm"}, "square:1.5V@0.1Hz", 20.0, -303.0, 1e-3),
-    ("pedot-micro", {}, "step:3V", 5.0, 0.0, 1e-3),
+    pytest.param("pedot-micro", {}, "step:3V", 5.0, 0.0, 1e-3, marks=pytest.mark.slow),
     ("pzt-hamr-small", {}, "sine:20V@500Hz,offset=100V", 0.01, 0.0, 1e-9),
     ("ppy-trilayer", {}, "square:0.5V@0.5Hz", 3.0, 0.0, 1e-9),
 ]

@@ -97,6 +97,7 @@ def test_import_mjeap_registers_every_id_cheaply():
     subprocess.run([sys.executable, "-c", code], check=True, timeout=120)
 
 
+@pytest.mark.slow
 def test_module_colon_id_imports_mjeap():
     """Gymnasium 1.x's ``module:id`` form: ``gymnasium.make("mjeap:mjeap/CurvatureTracking-v0")``
     without importing mjeap first. In a fresh interpreter."""

@@ -96,6 +96,7 @@ def test_a_fifo_nobody_reads_is_refused_before_any_work(tmp_path, monkeypatch):
     assert not steps and stat.S_ISFIFO(os.stat(fifo).st_mode)
 
 
+@pytest.mark.slow
 def test_stdout_on_a_pipe_takes_the_csv():
     p = _no_traceback(_cli("rollout", "pedot-micro", "--voltage", "step:1V", "--duration", "0.005",
                            "--csv", "/dev/stdout", "--quiet"))

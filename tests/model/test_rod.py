@@ -52,7 +52,8 @@ ALPHA_10_ROD_20 = pytest.mark.xfail(strict=True, reason=(
 
 
 @pytest.mark.parametrize("representation,segments", [
-    ("hinge", 20), pytest.param("rod", 20, marks=ALPHA_10_ROD_20), ("rod", 40)])
+    ("hinge", 20), pytest.param("rod", 20, marks=ALPHA_10_ROD_20),
+    pytest.param("rod", 40, marks=pytest.mark.slow)])
 def test_elastica_to_alpha_10_within_a_thousandth_of_L(representation, segments):
     """P L^2 / EI up to 10 (tip angle 82 degrees): the tip point within 0.1 % of L of the
     elastica (scipy solve_bvp), both coordinates."""

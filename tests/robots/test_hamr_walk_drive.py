@@ -31,6 +31,7 @@ def _sag_closed_form(system, legs: int) -> float:
     return hw.sprung_weight(system) * DOFS["lift"].ratio ** 2 * lam.tip_compliance() / legs
 
 
+@pytest.mark.slow
 def test_the_robot_sags_on_its_legs_as_the_lift_actuators_compliance_says(system):
     """At rest (no drive, 0.3 s) the body stands lower than its rigid-leg height (the feet
     FOOT_DROP + FOOT_RADIUS below the hips) by the sag on four legs, W T^2 / (4 k_tip) = 0.30

@@ -232,7 +232,8 @@ def test_transmission_inputs_are_named():
         add_transmission(spec, a, "nope", 4000.0)
 
 
-@pytest.mark.parametrize("wave,duration", [pytest.param("square:1V@2Hz", 0.5, marks=pytest.mark.slow), ("sine:1V@20Hz", 0.2)])
+@pytest.mark.slow
+@pytest.mark.parametrize("wave,duration", [("square:1V@2Hz", 0.5), ("sine:1V@20Hz", 0.2)])
 def test_a_system_estimates_its_step_error(wave, duration):
     """estimate_error: each actuator's tip-curvature error from the timestep, against the
     system at h / 2 (order 1.5 assumed). Reference: the same system at h / 16 (its own step

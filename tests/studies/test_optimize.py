@@ -52,6 +52,7 @@ def bimorph(tmp_path):
     return str(p)
 
 
+@pytest.mark.slow
 def test_the_cli_finds_the_closed_form_optimum_and_reruns_from_its_cache(bimorph, tmp_path, capsys):
     """The issue's command (10 segments, one start, to stay cheap): L within 1 % of L*, the
     floor active; result.json, evaluations.csv and optimum.toml written; a rerun reads

@@ -44,6 +44,7 @@ def test_failed_points_are_recorded_and_the_sweep_resumes(tmp_path):
     assert len(read_results(path)) == 5
 
 
+@pytest.mark.slow
 def test_processes_and_serial_agree(tmp_path):
     serial = run_sweep(POINTS, tmp_path / "a.csv", base=BASE, executor="serial", progress=False)
     procs = run_sweep(POINTS, tmp_path / "b.csv", base=BASE, executor="processes", workers=2, progress=False,
