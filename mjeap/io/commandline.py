@@ -36,11 +36,18 @@ def run_command(call: Callable[[], Optional[int]], prog: str = "mjeap") -> int:
     try:
         with sigterm_as_interrupt():
             code = call()
+            sys.stdout.flush()              # a closed pipe is told here, not at the interpreter's exit
     except MjeapError as e:
         print(f"{prog}: error: {printable(e)}", file=sys.stderr)
         for note in getattr(e, "__notes__", ()):      # e.g. an output that could not be written too
             print(f"{prog}: error: {printable(note)}", file=sys.stderr)
         return 2
+    except BrokenPipeError:                 # an OSError: caught before the clause below
+        # the reader of stdout went away (``mjeap ... | head``): the outputs are written; say
+        # so once on stderr, and point stdout at /dev/null so that Python's exit flush is quiet
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        print(f"{prog}: stdout was closed by its reader; the outputs asked for are written", file=sys.stderr)
+        return EXIT_BROKEN_PIPE
     except OSError as e:
         # a disk or system refusing a write outside mjeap's writer: one line, never a traceback
         if e.errno not in DISK_ERRORS:
@@ -55,12 +62,6 @@ def run_command(call: Callable[[], Optional[int]], prog: str = "mjeap") -> int:
         for note in getattr(e, "__notes__", ()):
             print(f"{prog}: error: {printable(note)}", file=sys.stderr)
         return EXIT_SIGTERM if term else EXIT_CTRL_C
-    except BrokenPipeError:
-        # the reader of stdout went away (``mjeap ... | head``): the outputs are written; say
-        # so once on stderr, and point stdout at /dev/null so that Python's exit flush is quiet
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        print(f"{prog}: stdout was closed by its reader; the outputs asked for are written", file=sys.stderr)
-        return EXIT_BROKEN_PIPE
     return 0 if code is None else int(code)
 
 

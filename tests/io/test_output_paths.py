@@ -103,6 +103,20 @@ def test_stdout_on_a_pipe_takes_the_csv():
     assert p.returncode == 0 and p.stdout.startswith("time (s),voltage (V)")
 
 
+@pytest.mark.parametrize("argv", [["list"], pytest.param(["show", "pzt-hamr-small"], marks=pytest.mark.slow)])
+def test_a_reader_that_closes_stdout_ends_the_command_in_one_line(argv):
+    """``mjeap list | head -1``: the reader goes away before mjeap writes; mjeap exits 141 (128
+    + SIGPIPE, as a shell reports it) with one line on stderr, never a traceback or Python's
+    'Exception ignored' at exit."""
+    p = subprocess.Popen([sys.executable, "-m", "mjeap.cli", *argv], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    p.stdout.close()                                  # the reader is gone before the first byte
+    err = p.stderr.read().decode()
+    assert p.wait(timeout=60) == 141, err
+    assert "Traceback" not in err and "Exception ignored" not in err
+    assert err.splitlines() == ["mjeap: stdout was closed by its reader; the outputs asked for are written"]
+
+
+
 @pytest.mark.parametrize("where", ["/proc/mjeap-test.rrd", "/sys/mjeap-test.rrd", "DIR", "BLOCK"])
 def test_paths_that_cannot_be_written_are_refused_naming_the_parameter(tmp_path, where):
     if where == "DIR":
