@@ -178,7 +178,7 @@ class _Worlds:
     def _graph(self, L: int):
         """The graph of ``L`` steps, step i's ctrl from row i of the ctrl buffer."""
         if L not in self.graphs:
-            wp, mjw = self.wp, self.mjw
+            wp = self.wp
             if self.ctrl.shape[0] < L:
                 self.ctrl = wp.zeros((L, self.B, self.m.nu), dtype=float)
                 self.graphs.clear()
@@ -264,7 +264,7 @@ def _roller(native, meta: Optional[dict]):
         if loads is not None:
             w.data.xfrc_applied.assign(loads.astype(np.float32))
         ctl = np.empty((B, 0, ncontrol))
-        before = state0
+        before = state = state0
         done = 0
 
         def advance(to: int) -> np.ndarray:
