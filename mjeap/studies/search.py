@@ -143,6 +143,7 @@ class Evaluations:
         else:
             row = evaluate(p, self.metrics, self.base)
             row.pop("_error_model", None)
+            row.pop("_field", None)                  # the box's fields are optimize's own check
             if self.out is not None:
                 self.out.write([row.get(k, "") for k in self.columns], len(self.cached) + self.run)
             self.run += 1

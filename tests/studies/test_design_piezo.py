@@ -218,3 +218,26 @@ def test_show_warns_of_a_layer_driven_past_its_recommended_field(tmp_path, capsy
     p.write_text(text)
     assert main(["show", str(p)]) == 0
     assert "warning: " in (err := capsys.readouterr().err) and "layer pzt sees 2.36 V/um" in err
+
+
+# ---------------------------------------------------------------- a sweep past the field limit
+def test_a_sweep_says_once_which_points_drive_a_layer_past_its_limit(tmp_path):
+    """Issue 42, never a silent answer: a sweep whose points thin the plates below V / E_max
+    (200 V over 2 V/um: 100 um) warns once, counting those points; reading max_field, its
+    column says it point by point and the sweep is quiet."""
+    from mjeap.model.laminate import FieldWarning
+    points = sweep.grid(**{"actuator.roles.piezo.thickness": [60e-6, 90e-6, 135e-6]})
+    base = {"actuator": HAMR, "waveform": "step", "amplitude": 200.0, "duration": 0.002, "segments": 4}
+    with pytest.warns(FieldWarning) as told:
+        s = sweep.run_sweep(points, tmp_path / "a.csv", metrics=("free_deflection",), base=base, executor="serial",
+                            progress=False)
+    assert s.done == 3 and s.failed == 0
+    [w] = [w for w in told if issubclass(w.category, FieldWarning)]
+    assert str(w.message).startswith("2 of the 3 points run drive a layer past its limit") and "V/um" in str(w.message)
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", FieldWarning)
+        sweep.run_sweep(points, tmp_path / "b.csv", metrics=("max_field",), base=base, executor="serial",
+                        progress=False)
+    fields = [float(r["max_field"]) for r in sweep.read_results(tmp_path / "b.csv")]
+    assert fields == pytest.approx([200 / 60e-6, 200 / 90e-6, 200 / 135e-6], rel=1e-9)

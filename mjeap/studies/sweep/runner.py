@@ -54,9 +54,12 @@ def evaluate(point: dict, metrics: Sequence[str] = ("peak_to_peak", "returns"), 
         row[m] = ""
     t0 = time.perf_counter()
     try:
-        with warnings.catch_warnings():     # a study's fields are its max_field metric's (or mjeap.optimize's check)
-            warnings.simplefilter("ignore", FieldWarning)
-            _evaluate_into(row, p, metrics, rrd_dir, error_model)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always", FieldWarning)
+            try:
+                _evaluate_into(row, p, metrics, rrd_dir, error_model)
+            finally:
+                _sort_warnings(row, caught)
     except MjeapError as e:
         row["error"] = f"{type(e).__name__}: {e}"
         if "returns" in metrics and isinstance(e, DivergenceError):
@@ -65,6 +68,26 @@ def evaluate(point: dict, metrics: Sequence[str] = ("peak_to_peak", "returns"), 
         row["error"] = f"{type(e).__name__}: {e} | {traceback.format_exc(limit=3)!r}"
     row["wall_s"] = time.perf_counter() - t0
     return row
+
+
+def _sort_warnings(row: dict, caught: list) -> None:
+    """A point's field warnings go into its row (``_field``, not a CSV column: the sweep says
+    them once, :func:`_say_fields`); every other warning is shown as it came."""
+    fields = [str(w.message) for w in caught if issubclass(w.category, FieldWarning)]
+    row["_field"] = fields[0] if fields else ""
+    for w in caught:
+        if not issubclass(w.category, FieldWarning):
+            warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+
+
+def _say_fields(past: List[tuple], done: int, columns: Sequence[str]) -> None:
+    """One :class:`~mjeap.model.laminate.FieldWarning` for the points whose drive takes a piezo
+    layer past its material's limits, unless the sweep reads ``max_field`` (then its column
+    says it, point by point)."""
+    if past and "max_field" not in columns and "max_reverse_field" not in columns:
+        warnings.warn(f"{len(past)} of the {done} points run drive a layer past its limit (point {past[0][0]}: "
+                      f"{past[0][1]}); add max_field to the metrics for each point's field", FieldWarning,
+                      stacklevel=5)
 
 
 def _evaluate_into(row: dict, p: dict, metrics: Sequence[str], rrd_dir, error_model) -> None:
@@ -509,7 +532,7 @@ def _run_locked(points, path, metrics, base, *, executor, workers, scheduler, re
 
 def _write_rows(path, columns, new_file, *, executor, workers, scheduler, jobs, bar, skipped, t0, share=True,
                 delimiter=","):
-    failed, done = 0, 0
+    failed, done, past = 0, 0, []
     out = RowFile(path, delimiter)
     try:
         if new_file:
@@ -519,10 +542,13 @@ def _write_rows(path, columns, new_file, *, executor, workers, scheduler, jobs, 
             out.write([row.get(k, "") for k in columns], done + skipped)
             done += 1
             failed += bool(row["error"])
+            if row.get("_field"):
+                past.append((row["point_id"], row["_field"]))
             if bar is not None:
                 bar.update(1)
     finally:
         out.close()
         if bar is not None:
             bar.close()
+    _say_fields(past, done, columns)
     return SweepSummary(path, done, skipped, failed, time.perf_counter() - t0)
