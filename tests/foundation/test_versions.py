@@ -56,7 +56,7 @@ def test_contact_system_runs_on_mujoco_4():
     """MuJoCo 4.0.0's sparse Cholesky bug made the Newton solver diverge on a gripping
     system (fixed upstream in 4.0.1); mjeap builds systems with a dense Jacobian there."""
     from mjeap.simulation.system import System, attach
-    from test_system import GRIP, host
+    from hosts import GRIP, host
     spec = host(GRIP)
     s = System(spec, [attach(spec, "pedot-micro", site=n, prefix=n) for n in ("left", "right")])
     r = s.rollout(["step:3V", "step:3V"], 0.2, sample_interval=0.01)

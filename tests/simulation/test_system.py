@@ -12,12 +12,7 @@ from mjeap import Scene, UnitSystem, rollout
 from mjeap.errors import ParameterError, UnknownNameError
 from mjeap.simulation.system import ContactParameters, System, attach
 
-G = "0 0 -0.00980665"      # standard gravity in mm / ms^2
-
-
-def host(body: str = "", extra: str = "", gravity: str = G) -> mujoco.MjSpec:
-    return mujoco.MjSpec.from_string(
-        f'<mujoco><option gravity="{gravity}"/><worldbody>{body}</worldbody>{extra}</mujoco>')
+from hosts import GRIP, host
 
 
 TILTED = '<body name="base" pos="1 -2 3" quat="0.9 0.2 -0.1 0.3"><site name="mount" pos="0.5 0 0" quat="0.8 0.1 0.3 0.2"/></body>'
@@ -119,15 +114,6 @@ def test_beam_pressing_on_a_block_gives_its_blocked_force():
     assert F == pytest.approx(chain_blocked_force(part, M, a_mm * 1e-3), rel=0.01)
     assert F == pytest.approx(1.5 * M / (a_mm * 1e-3), rel=0.02)
     assert s.penetration() < 0.01 * t * 1e-3
-
-
-# a polystyrene bead (1.05 g/cm^3) of radius 0.8 mm, wider than the fingers (1.37 mm), on a
-# floor; the fingers' faces 0.2 mm from it
-GRIP = ('<site name="left" pos="0 -1.0175 0"/>'
-        '<site name="right" pos="0 1.0175 0" quat="0 1 0 0"/>'
-        '<geom name="floor" type="box" size="10 10 0.1" pos="4 0 -0.9" rgba="0.8 0.8 0.8 1"/>'
-        '<body name="bead" pos="5 0 0"><freejoint/>'
-        '<geom name="bead" type="sphere" size="0.8" mass="2.25" rgba="0.9 0.7 0.1 1"/></body>')
 
 
 def test_two_actuators_close_on_a_free_body():
