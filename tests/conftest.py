@@ -30,6 +30,7 @@ def pytest_configure(config):
         config.addinivalue_line("markers", f"layer_{layer}: a test in tests/{layer}/ (tests/conftest.py LAYERS)")
 
 
+@pytest.hookimpl(tryfirst=True)        # before -m selects: a test parametrised with 'cable' is marked cable
 def pytest_collection_modifyitems(config, items):
     """On MuJoCo 4.x the cable (removed there) and dm_control's Physics (fails there) are
     refused by mjeap, which tests/foundation/test_versions.py checks; the tests that need them are
@@ -54,7 +55,9 @@ def pytest_collection_modifyitems(config, items):
         if layer:
             item.add_marker(f"layer_{layer}")
         params = getattr(getattr(item, "callspec", None), "params", {})
-        if not has_cable and ("cable" in item.keywords or any(isinstance(v, str) and v == "cable" for v in values(params))):
+        if any(isinstance(v, str) and v == "cable" for v in values(params)):
+            item.add_marker("cable")
+        if not has_cable and "cable" in item.keywords:
             item.add_marker(no_cable)
         if rod_problem and ("rod" in item.keywords or any(isinstance(v, str) and v == "rod" for v in values(params))):
             item.add_marker(no_rod)
