@@ -43,9 +43,9 @@ def main(argv=None):
     a = ap.parse_args(argv)
     out = Path(a.out)
     figure = importlib.util.find_spec("matplotlib") is not None
-    if not figure and a.png:            # a file asked for by name is never silently left out
-        ap.error("--png: the figure needs matplotlib, which is not installed (pip install \"mjeap[report]\")")
     if not figure:                      # said before the work, not after it
+        if a.png:                       # a file asked for by name is never silently left out
+            ap.error("--png: the figure needs matplotlib, which is not installed (pip install \"mjeap[report]\")")
         print("design_study: matplotlib is not installed: the figure is left out (pip install \"mjeap[report]\" "
               "for it); the sweep and the optimisation run", file=sys.stderr)
     points = grid(**{"actuator.length": [float(x) for x in LENGTHS],

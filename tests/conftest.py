@@ -55,11 +55,13 @@ def pytest_collection_modifyitems(config, items):
         if layer:
             item.add_marker(f"layer_{layer}")
         params = getattr(getattr(item, "callspec", None), "params", {})
-        if any(isinstance(v, str) and v == "cable" for v in values(params)):
-            item.add_marker("cable")
+        texts = {v for v in values(params) if isinstance(v, str)}
+        for representation in ("cable", "rod"):      # parametrised with it: marked with it
+            if representation in texts:
+                item.add_marker(representation)
         if not has_cable and "cable" in item.keywords:
             item.add_marker(no_cable)
-        if rod_problem and ("rod" in item.keywords or any(isinstance(v, str) and v == "rod" for v in values(params))):
+        if rod_problem and "rod" in item.keywords:
             item.add_marker(no_rod)
         if dmc_problem and "dm_control" in item.keywords:
             item.add_marker(no_dmc)

@@ -43,10 +43,12 @@ def run_command(call: Callable[[], Optional[int]], prog: str = "mjeap") -> int:
             print(f"{prog}: error: {printable(note)}", file=sys.stderr)
         return 2
     except BrokenPipeError:                 # an OSError: caught before the clause below
-        # the reader of stdout went away (``mjeap ... | head``): the outputs are written; say
-        # so once on stderr, and point stdout at /dev/null so that Python's exit flush is quiet
+        # the reader of stdout went away (``mjeap ... | head``): say once on stderr that the rest
+        # of stdout is dropped (an output sent to stdout included), and point stdout at
+        # /dev/null so that Python's exit flush is quiet
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        print(f"{prog}: stdout was closed by its reader; the outputs asked for are written", file=sys.stderr)
+        print(f"{prog}: stdout was closed by its reader; the rest of what was to go there is dropped",
+              file=sys.stderr)
         return EXIT_BROKEN_PIPE
     except OSError as e:
         # a disk or system refusing a write outside mjeap's writer: one line, never a traceback

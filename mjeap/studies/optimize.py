@@ -539,7 +539,8 @@ def _check_fields(actuator, fixed: dict, corners: List[dict], constraints) -> No
     from ..drives.piezo import LinearPiezo
     from ..model.laminate import FieldWarning
     from ..simulation.scene import Scene
-    if any(c.metric in ("max_field", "max_reverse_field") for c in constraints):
+    from .sweep.metrics import FIELD_METRICS
+    if any(c.metric in FIELD_METRICS for c in constraints):
         return
     texts = []
     for c in corners:

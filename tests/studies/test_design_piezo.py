@@ -15,6 +15,7 @@ limits, and never a silent answer.
 """
 import importlib.util
 import json
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -234,7 +235,6 @@ def test_a_sweep_says_once_which_points_drive_a_layer_past_its_limit(tmp_path):
     assert s.done == 3 and s.failed == 0
     [w] = [w for w in told if issubclass(w.category, FieldWarning)]
     assert str(w.message).startswith("2 of the 3 points run drive a layer past its limit") and "V/um" in str(w.message)
-    import warnings
     with warnings.catch_warnings():
         warnings.simplefilter("error", FieldWarning)
         sweep.run_sweep(points, tmp_path / "b.csv", metrics=("max_field",), base=base, executor="serial",

@@ -451,13 +451,15 @@ STEP_ONLY_METRICS = {
 #: metrics of a periodic drive, refused under a step: what to read instead
 PERIODIC_ONLY_METRICS = {"stroke": "a periodic waveform (square, sine or triangle with a frequency > 0): under a step "
                                    "read free_deflection"}
+#: metrics that read a piezo layer's field: a study that reads one says its fields in that column
+FIELD_METRICS = ("max_field", "max_reverse_field")
 #: metrics that read a piezo laminate (the piezo and piezo-bimorph drives)
-PIEZO_METRICS = ("max_field", "max_reverse_field", "max_stress", "capacitance")
+PIEZO_METRICS = (*FIELD_METRICS, "max_stress", "capacitance")
 PIEZO_ONLY = "an actuator with a piezo drive (piezo or piezo-bimorph: a laminate of piezo layers)"
 
 
 #: a row's own columns, which no metric may be named
-ROW_COLUMNS = ("point_id", "error", "wall_s", "settings", "_error_model")
+ROW_COLUMNS = ("point_id", "error", "wall_s", "settings", "_error_model", "_field")
 
 
 def register_metric(name: str, fn: Callable, *, replace: bool = False, rollout: bool = True) -> None:

@@ -84,7 +84,7 @@ def _say_fields(past: List[tuple], done: int, columns: Sequence[str]) -> None:
     """One :class:`~mjeap.model.laminate.FieldWarning` for the points whose drive takes a piezo
     layer past its material's limits, unless the sweep reads ``max_field`` (then its column
     says it, point by point)."""
-    if past and "max_field" not in columns and "max_reverse_field" not in columns:
+    if past and not set(_metrics.FIELD_METRICS) & set(columns):
         warnings.warn(f"{len(past)} of the {done} points run drive a layer past its limit (point {past[0][0]}: "
                       f"{past[0][1]}); add max_field to the metrics for each point's field", FieldWarning,
                       stacklevel=5)
