@@ -80,11 +80,7 @@ def resolve_actuator(name):
     if isinstance(name, (ActuatorRef, Actuator)) or not isinstance(name, (str, Path)):
         return name
     if is_actuator_file(name):
-        p = Path(name)
-        try:
-            data = p.read_bytes() if p.is_file() else None
-        except OSError:
-            data = None
+        data = _file_bytes(name)
         act = file_actuator(str(name), data)     # refused here, naming the file, where it is not one
         return ActuatorRef(str(name), act, None if data is None else hashlib.sha1(data).hexdigest())
     return ActuatorRef(str(name), get_actuator(name))
@@ -127,10 +123,7 @@ def file_actuator(path, data: Optional[bytes] = None) -> Actuator:
     where the caller has read them already."""
     p = Path(path)
     if data is None:
-        try:
-            data = p.read_bytes() if p.is_file() else None
-        except OSError:
-            data = None
+        data = _file_bytes(p)
     if data is None:                    # read_actuator says what is wrong with it
         return read_actuator(path)
     key = (str(path), os.path.realpath(p), hashlib.blake2b(data, digest_size=16).digest())
@@ -144,6 +137,16 @@ def file_actuator(path, data: Optional[bytes] = None) -> Actuator:
     for message, category in told:      # what reading the file warns, every time it is read
         warnings.warn(message, category, stacklevel=3)
     return act
+
+
+def _file_bytes(path) -> Optional[bytes]:
+    """The bytes of the regular file ``path``; None where it is not one or cannot be read
+    (:func:`read_actuator` then says why)."""
+    p = Path(path)
+    try:
+        return p.read_bytes() if p.is_file() else None
+    except OSError:
+        return None
 
 
 def check_actuator_files(names) -> None:
